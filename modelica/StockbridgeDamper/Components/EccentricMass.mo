@@ -1,0 +1,35 @@
+within StockbridgeDamper.Components;
+model EccentricMass "Rigid end mass on a rigid link: centre offset a from the node along the cable (small rotations)"
+  parameter Real m(unit="kg", min=0) = 0.8 "Mass";
+  parameter Real J_G(unit="kg.m2", min=0) = 1.68e-3 "Moment of inertia about the centre of mass";
+  parameter Real a(unit="m") = 0.0325 "Offset of the centre of mass from the node, outward along the cable; 0 puts it on the node";
+  parameter Real side(unit="1") = 1 "Direction of 'outward': +1 if the mass sits at the node's +axial side, -1 at its -axial side";
+  parameter Real alpha_pd(unit="1/s") = 0 "Mass-proportional Rayleigh damping coefficient";
+  Interfaces.BeamFlange flange "Node the mass is attached to";
+  Interfaces.BeamFlange support "Reference frame of the damping (connect to the clamp): damping acts on the velocity relative to its vertical motion and its reaction acts on it";
+  Real x(unit="m", start=0) "Vertical displacement of the node";
+  Real phi(unit="rad", start=0) "Rotation of the node";
+  Real v(unit="m/s", start=0) "Vertical velocity of the node";
+  Real w(unit="rad/s", start=0) "Angular velocity of the node";
+  Real acc(unit="m/s2") "Vertical acceleration of the node";
+  Real alp(unit="rad/s2") "Angular acceleration of the node";
+  Real xg(unit="m") "Vertical displacement of the centre of mass";
+  Real vs(unit="m/s") "Vertical velocity of the damping reference frame";
+  Real fd(unit="N") "Mass-proportional damping force (vertical)";
+  Real td(unit="N.m") "Mass-proportional damping moment";
+equation
+  x = flange.x;
+  phi = flange.phi;
+  v = der(x);
+  w = der(phi);
+  acc = der(v);
+  alp = der(w);
+  vs = der(support.x);
+  xg = x + side*a*phi;
+  fd = alpha_pd*(m*(v - vs) + side*m*a*w);
+  td = alpha_pd*(side*m*a*(v - vs) + (J_G + m*a^2)*w);
+  flange.f = m*(acc + side*a*alp) + fd;
+  flange.tau = side*m*a*acc + (J_G + m*a^2)*alp + td;
+  support.f = -fd;
+  support.tau = 0;
+end EccentricMass;

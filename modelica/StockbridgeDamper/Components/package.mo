@@ -1,0 +1,3 @@
+within StockbridgeDamper;
+package Components "Masses, springs, dampers, hysteretic and nonlinear elements, beam elements"
+end Components;

@@ -1,0 +1,3 @@
+within StockbridgeDamper;
+package Examples "Example systems exported as FMUs"
+end Examples;

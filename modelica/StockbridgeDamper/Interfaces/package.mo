@@ -1,0 +1,3 @@
+within StockbridgeDamper;
+package Interfaces "Connectors and partial models"
+end Interfaces;

@@ -1,0 +1,3 @@
+within StockbridgeDamper;
+package Sources "Force and motion sources with built-in parameterised excitations"
+end Sources;

@@ -1,0 +1,209 @@
+"""Run one FMU many times through fmpy: extract once, instantiate once, reset between runs.
+
+Co-simulation runs are driven here (not by fmpy.simulate_fmu) so that the input derivatives of a
+sampled input reach the FMU: fmpy 0.3.32's simulate_fmu(set_input_derivatives=True) only works for
+FMUs with exactly nine real inputs (a fixed-size buffer). Between two samples the input is linear,
+and its slope is sent with fmi2SetRealInputDerivatives. Model Exchange runs use fmpy's CVode driver,
+which applies inputs at communication points only.
+"""
+from __future__ import annotations
+
+import ctypes
+import pathlib
+import shutil
+from dataclasses import dataclass, field
+
+import numpy as np
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Model, FMU2Slave
+
+
+class ParameterError(ValueError):
+    """A parameter name or value the FMU does not accept."""
+
+
+@dataclass
+class SimulationResult:
+    """Outputs on a uniform time grid, or a failure with its reason (never an exception)."""
+
+    time: np.ndarray
+    values: dict[str, np.ndarray]
+    ok: bool = True
+    message: str = ""
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.values[name]
+
+
+@dataclass
+class FmuRunner:
+    """Picklable handle to one FMU file; the FMU itself is loaded lazily in the process that runs it."""
+
+    path: str
+    interface: str = "CoSimulation"  # or "ModelExchange"
+    _state: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def __getstate__(self):
+        return {"path": self.path, "interface": self.interface, "_state": {}}
+
+    # ---- loading ---------------------------------------------------------------------------------
+    @property
+    def model_description(self):
+        if "md" not in self._state:
+            self._state["md"] = read_model_description(self.path)
+        return self._state["md"]
+
+    @property
+    def variables(self) -> dict:
+        """name -> fmpy ScalarVariable."""
+        if "vars" not in self._state:
+            self._state["vars"] = {v.name: v for v in self.model_description.modelVariables}
+        return self._state["vars"]
+
+    def parameter_names(self) -> list[str]:
+        """Names of the parameters that can be set before a run."""
+        return [v.name for v in self.model_description.modelVariables if v.causality == "parameter"]
+
+    def _instance(self):
+        if "fmu" not in self._state:
+            md = self.model_description
+            unzip = extract(self.path)
+            cls = FMU2Slave if self.interface == "CoSimulation" else FMU2Model
+            ident = (md.coSimulation if self.interface == "CoSimulation" else md.modelExchange).modelIdentifier
+            fmu = cls(guid=md.guid, unzipDirectory=unzip, modelIdentifier=ident, instanceName="pyfit")
+            fmu.instantiate()
+            self._state.update(fmu=fmu, unzip=unzip)
+        return self._state["fmu"]
+
+    def close(self):
+        """Free the instance and delete the extracted files."""
+        fmu = self._state.pop("fmu", None)
+        if fmu is not None:
+            fmu.freeInstance()
+        unzip = self._state.pop("unzip", None)
+        if unzip:
+            shutil.rmtree(unzip, ignore_errors=True)
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    # ---- parameters ------------------------------------------------------------------------------
+    def check_parameters(self, params: dict) -> None:
+        """Reject unknown names (listing the valid ones) and values outside declared min/max."""
+        valid = set(self.parameter_names())
+        settable = valid | {v.name for v in self.model_description.modelVariables
+                            if v.causality == "local" and v.initial == "exact"}
+        for name, value in params.items():
+            if name not in settable:
+                raise ParameterError(f"{pathlib.Path(self.path).name}: unknown parameter '{name}'; "
+                                     f"valid parameters: {', '.join(sorted(valid))}")
+            v = self.variables[name]
+            lo = float(v.min) if v.min is not None else -np.inf
+            hi = float(v.max) if v.max is not None else np.inf
+            if not np.isfinite(value) or not lo <= value <= hi:
+                raise ParameterError(f"{pathlib.Path(self.path).name}: parameter '{name}' = {value} outside "
+                                     f"[{lo}, {hi}]")
+
+    def _apply(self, fmu, params: dict):
+        for name, value in params.items():
+            v = self.variables[name]
+            if v.type == "Integer":
+                fmu.setInteger([v.valueReference], [int(value)])
+            elif v.type == "Boolean":
+                fmu.setBoolean([v.valueReference], [bool(value)])
+            else:
+                fmu.setReal([v.valueReference], [float(value)])
+
+    # ---- simulation ------------------------------------------------------------------------------
+    def simulate(self, stop_time: float, output_interval: float, outputs: list[str],
+                 params: dict | None = None, inputs: dict[str, np.ndarray] | None = None,
+                 input_time: np.ndarray | None = None, tolerance: float = 1e-8,
+                 start_time: float = 0.0) -> SimulationResult:
+        """Simulate from start_time to stop_time; outputs sampled every output_interval (uniform grid).
+
+        inputs: name -> samples at input_time (linear in between). A failing or diverging run returns
+        SimulationResult(ok=False) with the reason; invalid parameter names raise ParameterError.
+        """
+        params = dict(params or {})
+        self.check_parameters(params)
+        for name in outputs + list(inputs or {}):
+            if name not in self.variables:
+                raise ParameterError(f"{pathlib.Path(self.path).name}: no variable '{name}'")
+        n = int(round((stop_time - start_time) / output_interval))
+        if n < 1 or abs(start_time + n * output_interval - stop_time) > 1e-9 * max(1.0, abs(stop_time)):
+            raise ValueError(f"stop_time - start_time = {stop_time - start_time} is not a whole number of "
+                             f"output intervals {output_interval}")
+        time = start_time + output_interval * np.arange(n + 1)
+        try:
+            fmu = self._instance()
+            fmu.reset()
+            if self.interface == "CoSimulation":
+                vals = self._run_cs(fmu, time, outputs, params, inputs, input_time, tolerance)
+            else:
+                vals = self._run_me(fmu, time, outputs, params, inputs, input_time, tolerance)
+        except (FMICallException, OSError, RuntimeError) as exc:
+            self._state.pop("fmu", None)  # the instance may be unusable: make a fresh one next time
+            return SimulationResult(time, {o: np.full(len(time), np.nan) for o in outputs}, False, str(exc))
+        dt = np.diff(time)
+        assert np.allclose(dt, output_interval, rtol=1e-9, atol=0), "output grid is not uniform"
+        return SimulationResult(time, vals)
+
+    def _run_cs(self, fmu, time, outputs, params, inputs, input_time, tolerance):
+        fmu.setupExperiment(tolerance=tolerance, startTime=time[0])
+        self._apply(fmu, params)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        out_vr = (ctypes.c_uint * len(outputs))(*[self.variables[o].valueReference for o in outputs])
+        out_buf = (ctypes.c_double * len(outputs))()
+        result = np.empty((len(time), len(outputs)))
+        in_names = list(inputs or {})
+        k = len(in_names)
+        if k:
+            in_vr = (ctypes.c_uint * k)(*[self.variables[nm].valueReference for nm in in_names])
+            table = np.vstack([np.asarray(inputs[nm], float) for nm in in_names])
+            it = np.asarray(input_time, float)
+            u_at = np.vstack([np.interp(time, it, row) for row in table])
+            # slope of the linear input on the segment that starts at each communication point
+            idx = np.clip(np.searchsorted(it, time, side="right") - 1, 0, len(it) - 2)
+            slope = (table[:, idx + 1] - table[:, idx]) / (it[idx + 1] - it[idx])
+            in_buf = (ctypes.c_double * k)()
+            der_buf = (ctypes.c_double * k)()
+            order = (ctypes.c_int * k)(*([1] * k))
+        get_real, do_step = fmu.fmi2GetReal, fmu.fmi2DoStep
+        set_real, set_der = fmu.fmi2SetReal, fmu.fmi2SetRealInputDerivatives
+        comp = fmu.component
+        for i, t in enumerate(time):
+            if k:
+                in_buf[:] = u_at[:, i]
+                set_real(comp, in_vr, k, in_buf)
+            get_real(comp, out_vr, len(outputs), out_buf)
+            result[i] = out_buf[:]
+            if i + 1 < len(time):
+                if k:
+                    der_buf[:] = slope[:, i]
+                    set_der(comp, in_vr, k, order, der_buf)
+                do_step(comp, t, time[i + 1] - t, 1)
+        fmu.terminate()
+        return {o: result[:, j].copy() for j, o in enumerate(outputs)}
+
+    def _run_me(self, fmu, time, outputs, params, inputs, input_time, tolerance):
+        from fmpy import simulate_fmu
+
+        sig = None
+        if inputs:
+            names = list(inputs)
+            sig = np.zeros(len(input_time), dtype=[("time", float)] + [(nm, float) for nm in names])
+            sig["time"] = input_time
+            for nm in names:
+                sig[nm] = inputs[nm]
+        res = simulate_fmu(self.path, fmi_type="ModelExchange", fmu_instance=fmu,
+                           model_description=self.model_description, start_time=time[0], stop_time=time[-1],
+                           output_interval=time[1] - time[0], relative_tolerance=tolerance,
+                           start_values=params, input=sig, output=outputs, terminate=True, validate=False)
+        rt = res["time"]
+        # fmpy may add points at events; keep the uniform grid
+        return {o: np.interp(time, rt, res[o]) for o in outputs}
