@@ -201,6 +201,10 @@ class _Reducer:
         return False
 
     def run(self):
+        if len(self.eqs) != len(self.unknown):
+            raise ModelicaError(
+                f"{self.flat.name}: the model is not balanced: {len(self.eqs)} equations for {len(self.unknown)} "
+                f"unknowns (state derivatives and algebraic variables)")
         while self._try_eliminate() or self._try_constraint():
             pass
         self._solve_blocks()

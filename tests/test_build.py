@@ -1,0 +1,89 @@
+"""The build: every example becomes a valid FMI 2.0 FMU (ME + CS) whose two interfaces agree."""
+import pathlib
+import shutil
+import zipfile
+
+import numpy as np
+import pytest
+from fmpy import read_model_description
+from fmpy.validation import validate_fmu
+
+from pyfit.build import EXAMPLES, LIBRARY, ModelicaError, build_all
+from pyfit.fmu import ParameterError
+
+# name -> (outputs compared, parameters for a short nonlinear run, stop time [s])
+RUNS = {
+    "SDOFBoucWen": (["y", "z"], {"exc_rate": 6.0}, 6.0),
+    "TwoDOFa": (["y1", "y2", "z"], {"exc_rate": 6.0}, 6.0),
+    "TwoDOFb": (["y1", "y2", "z"], {"exc_rate": 6.0}, 6.0),
+    "TwoDOFc": (["y1", "y2", "z"], {"exc_rate": 6.0}, 6.0),
+    "TwoDOFd": (["y1", "y2", "z"], {"exc_rate": 6.0}, 6.0),
+    "StockbridgeDamper": (["x1", "x2", "F_clamp"], {"exc_rate": 10.0}, 3.5),
+}
+
+
+@pytest.mark.parametrize("name", list(EXAMPLES))
+def test_fmu_is_valid_fmi2_with_me_and_cs(fmu_dir, name):
+    path = fmu_dir / f"{name}.fmu"
+    assert validate_fmu(str(path)) == []
+    md = read_model_description(str(path))
+    assert md.fmiVersion == "2.0"
+    assert md.modelExchange is not None and md.coSimulation is not None
+    assert md.coSimulation.canInterpolateInputs
+    names = {v.name for v in md.modelVariables}
+    with zipfile.ZipFile(path) as z:
+        files = z.namelist()
+    assert "sources/model_functions.c" in files and "sources/fmi2_wrapper.c" in files
+    # every parameter carries a description; physical ones carry a unit
+    params = [v for v in md.modelVariables if v.causality == "parameter"]
+    assert params and all(v.description for v in params)
+    if name == "StockbridgeDamper":
+        assert {"EI", "mu", "L1", "L2", "k_bw1", "k_cs2", "x_base", "v_base", "a_base", "F_clamp"} <= names
+        assert next(v for v in md.modelVariables if v.name == "EI").unit == "N.m2"
+    if name == "SDOFBoucWen":
+        assert {"m", "c", "k", "alpha", "beta", "gamma", "delta", "nu", "u", "y", "v", "z"} <= names
+
+
+@pytest.mark.parametrize("name", list(EXAMPLES))
+def test_model_exchange_and_co_simulation_agree(runner, name):
+    outputs, params, stop = RUNS[name]
+    cs = runner(name).simulate(stop, 1e-3, outputs, params, tolerance=1e-11)
+    me = runner(name, "ModelExchange").simulate(stop, 1e-3, outputs, params, tolerance=1e-11)
+    assert cs.ok and me.ok, (cs.message, me.message)
+    for o in outputs:
+        ref = np.max(np.abs(cs[o]))
+        assert ref > 0
+        assert np.max(np.abs(cs[o] - me[o])) / ref <= 1e-6, o
+
+
+def test_unknown_parameter_lists_the_valid_names(runner):
+    with pytest.raises(ParameterError) as err:
+        runner("SDOFBoucWen").simulate(0.1, 1e-3, ["y"], {"kk": 1.0})
+    msg = str(err.value)
+    assert "'kk'" in msg and "alpha" in msg and "exc_amplitude" in msg
+
+
+def test_syntax_error_names_file_and_line_and_builds_nothing(tmp_path):
+    lib = tmp_path / "modelica"
+    shutil.copytree(LIBRARY, lib)
+    bad = lib / "StockbridgeDamper" / "Components" / "Spring.mo"
+    lines = bad.read_text().splitlines()
+    eq_line = next(i for i, l in enumerate(lines) if "f = k*s_rel" in l)
+    lines[eq_line] = "  f = k*s_rel +;"
+    bad.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "out"
+    with pytest.raises(ModelicaError) as err:
+        build_all(out, library=lib)
+    assert f"{bad}:{eq_line + 1}" in str(err.value)
+    assert not out.exists() or not list(out.iterdir())
+
+
+def test_semantic_error_builds_nothing(tmp_path):
+    lib = tmp_path / "modelica"
+    shutil.copytree(LIBRARY, lib)
+    bad = lib / "StockbridgeDamper" / "Components" / "SpringDamper.mo"
+    bad.write_text(bad.read_text().replace("f = k*s_rel + c*v_rel;", "f = k*s_rel + c*v_rel;\n  f = 2*c*v_rel;"))
+    out = tmp_path / "out"
+    with pytest.raises(ModelicaError, match="not balanced: 62 equations for 59 unknowns"):
+        build_all(out, ["TwoDOFa"], library=lib)
+    assert not out.exists() or not list(out.glob("*.fmu"))
