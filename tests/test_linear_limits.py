@@ -1,0 +1,95 @@
+"""Linear limits: modal parameters ESTIMATED from simulated free decays (ERA) against independent
+computations (analytic formulas, numpy eigenvalues of independently assembled matrices)."""
+import numpy as np
+import pytest
+
+from pyfit.modal import free_decay_modes, state_space_modes
+
+DT = 5e-4
+
+
+def test_sdof_linear_limit_natural_frequency_and_damping(runner):
+    # beta = 0: z = alpha*y exactly when the decay starts from y = 0 with an initial velocity
+    res = runner("SDOFBoucWen").simulate(1.0, DT, ["y"], {"beta": 0.0, "exc_type": 0, "mass.v": 0.1},
+                                         tolerance=1e-11)
+    assert res.ok
+    (mode,) = free_decay_modes(res["y"], DT, 1)
+    m, c, k, alpha = 2.0, 10.0, 5e4, 5e4
+    f0 = np.sqrt((k + alpha) / m) / (2 * np.pi)  # 35.59 Hz, seed Table 4.2
+    zeta = c / (2 * np.sqrt((k + alpha) * m))  # 1.12 %
+    assert f0 == pytest.approx(35.59, abs=0.01) and zeta == pytest.approx(0.0112, abs=1e-4)
+    assert mode.f_n == pytest.approx(f0, rel=0.005)
+    assert mode.zeta == pytest.approx(zeta, rel=0.05)
+
+
+def _two_dof_matrices(config, alpha):
+    m1, m2, k1, k2, k12, c1, c2, c12 = 0.5, 1.0, 2000.0, 5000.0, 500.0, 5.0, 2.0, 1.0
+    M = np.diag([m1, m2])
+    K = np.array([[k1 + k12, -k12], [-k12, k2 + k12]])
+    C = np.array([[c1 + c12, -c12], [-c12, c2 + c12]])
+    if config in "ac":  # linearised Bouc-Wen (stiffness alpha) between mass 2 and ground
+        K = K + np.array([[0, 0], [0, alpha]])
+    else:  # between the masses
+        K = K + alpha * np.array([[1, -1], [-1, 1]])
+    return M, C, K
+
+
+@pytest.mark.parametrize("config", "abcd")
+def test_two_dof_linear_modes_match_numpy_eigenvalues(runner, config):
+    params = {"beta": 0.0, "exc_type": 0, "mass1.v": 0.05}
+    if config in "cd":
+        params["k_nl"] = 0.0
+    res = runner(f"TwoDOF{config}").simulate(2.0, DT, ["y1", "y2"], params, tolerance=1e-11)
+    assert res.ok
+    est = free_decay_modes(np.column_stack([res["y1"], res["y2"]]), DT, 2)
+    ref = state_space_modes(*_two_dof_matrices(config, alpha=500.0))
+    for e, r in zip(est, ref):
+        assert e.f_d == pytest.approx(r.f_d, rel=1e-3)
+        assert e.zeta == pytest.approx(r.zeta, rel=1e-2)
+
+
+def _damper_matrices():
+    """Independent assembly of design section 1.3: DOFs [x1, phi1, xc, phic, x2, phi2], clamp held."""
+    EI, mu, L1, L2 = 10.0, 0.3, 0.17, 0.12
+    K = np.zeros((6, 6))
+    M = np.zeros((6, 6))
+    for i, L in ((0, L1), (2, L2)):
+        K[i:i + 4, i:i + 4] += EI / L**3 * np.array(
+            [[12, 6 * L, -12, 6 * L], [6 * L, 4 * L**2, -6 * L, 2 * L**2],
+             [-12, -6 * L, 12, -6 * L], [6 * L, 2 * L**2, -6 * L, 4 * L**2]])
+        M[i:i + 4, i:i + 4] += mu * L / 420 * np.array(
+            [[156, 22 * L, 54, -13 * L], [22 * L, 4 * L**2, 13 * L, -3 * L**2],
+             [54, 13 * L, 156, -22 * L], [-13 * L, -3 * L**2, -22 * L, 4 * L**2]])
+    for node, m, J, a, side in ((0, 0.8, 1.68e-3, 0.0325, -1), (4, 0.6, 1.26e-3, 0.0325, 1)):
+        M[node:node + 2, node:node + 2] += [[m, side * m * a], [side * m * a, J + m * a * a]]
+    free = [0, 1, 4, 5]
+    M, K = M[np.ix_(free, free)], K[np.ix_(free, free)]
+    return M, 2.0 * M + 2e-4 * K, K
+
+
+def test_damper_reference_matrices_have_the_design_frequencies():
+    M, _, K = _damper_matrices()
+    undamped = np.sqrt(np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)) / (2 * np.pi)
+    np.testing.assert_allclose(undamped, [10.1, 17.3, 79.0, 125.0], rtol=0.01)
+
+
+def test_damper_linear_modes_match_independent_matrices(runner):
+    # a smooth 10 ms clamp pulse (exact x, v, a), then the clamp rests and the damper rings down
+    T = 0.01
+    t = np.arange(0, 1.0 + DT / 2, DT / 4)
+    s = np.clip(t / T, 0, 1)
+    x = 1e-3 * np.sin(np.pi * s) ** 4
+    v = np.gradient(x, t)
+    a = np.gradient(v, t)
+    params = {"k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "exc_type": 0}
+    res = runner("StockbridgeDamper").simulate(1.0, DT, ["x1", "x2", "phi1", "phi2"], params,
+                                               inputs={"x_base": x, "v_base": v, "a_base": a}, input_time=t,
+                                               tolerance=1e-11)
+    assert res.ok
+    keep = res.time > 2 * T
+    Y = np.column_stack([res[o][keep] for o in ("x1", "x2", "phi1", "phi2")])
+    est = free_decay_modes(Y, DT, 4)
+    ref = state_space_modes(*_damper_matrices())
+    assert len(est) == 4
+    for e, r in zip(est, ref):
+        assert e.f_d == pytest.approx(r.f_d, rel=0.005)
