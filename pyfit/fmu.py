@@ -168,7 +168,10 @@ class FmuRunner:
             it = np.asarray(input_time, float)
             u_at = np.vstack([np.interp(time, it, row) for row in table])
             # slope of the linear input on the segment that starts at each communication point
-            idx = np.clip(np.searchsorted(it, time, side="right") - 1, 0, len(it) - 2)
+            # (a communication point within 1e-6 of an input sample counts as that sample: rounding of
+            # the two time grids must not select the previous segment)
+            tol = 1e-6 * np.min(np.diff(it))
+            idx = np.clip(np.searchsorted(it, time + tol, side="right") - 1, 0, len(it) - 2)
             slope = (table[:, idx + 1] - table[:, idx]) / (it[idx + 1] - it[idx])
             in_buf = (ctypes.c_double * k)()
             der_buf = (ctypes.c_double * k)()

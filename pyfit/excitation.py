@@ -1,0 +1,106 @@
+"""Excitation signals of design section 2, as functions of time that work on numpy arrays and on CasADi symbols.
+
+The same formulas are built into the FMUs (Modelica `Sources.Excitation`); these are an independent
+implementation, used to drive the CasADi reference and to make input arrays.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+KINDS = {0: "off", 1: "sine", 2: "linear sweep", 3: "log sweep", 4: "constant-velocity linear sweep",
+         5: "constant-velocity log sweep"}
+
+
+@dataclass(frozen=True)
+class Excitation:
+    """Built-in excitation: kind as in the FMUs' exc_type; amplitude in the signal's unit (kinds 1-3) or
+    velocity amplitude in m/s with a displacement signal (kinds 4-5). Frequencies in Hz, rate in Hz/s,
+    octaves_per_minute for log sweeps, t_ramp [s] for a C2-smooth ramp-in from zero."""
+
+    kind: int = 0
+    amplitude: float = 1.0
+    f_start: float = 1.0
+    f_end: float = 60.0
+    rate: float = 0.5
+    octaves_per_minute: float = 1.0
+    t_ramp: float = 0.0
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise ValueError(f"excitation kind {self.kind} unknown; valid: {KINDS}")
+        if self.kind in (3, 4, 5) and self.f_start <= 0:
+            raise ValueError("log and constant-velocity sweeps need f_start > 0")
+
+    def frequency(self, t):
+        """Instantaneous frequency [Hz]."""
+        xp = _ops(t)
+        if self.kind == 1:
+            return self.f_start + 0 * t
+        if self.kind in (2, 4):
+            return self.f_start + self.rate * xp.minimum(t, self._t_end())
+        k = self.octaves_per_minute / 60.0
+        return self.f_start * 2.0 ** (k * xp.minimum(t, self._t_end()))
+
+    def _t_end(self):
+        if self.kind in (2, 4):
+            return (self.f_end - self.f_start) / self.rate
+        if self.kind in (3, 5):
+            return np.log2(self.f_end / self.f_start) / (self.octaves_per_minute / 60.0)
+        return np.inf
+
+    def phase(self, t):
+        """Phase [rad], continuous; after the sweep the frequency stays at f_end."""
+        xp = _ops(t)
+        if self.kind == 1:
+            return 2 * np.pi * self.f_start * t
+        te = xp.minimum(t, self._t_end())
+        if self.kind in (2, 4):
+            return 2 * np.pi * (self.f_start * te + 0.5 * self.rate * te**2 + self.f_end * (t - te))
+        k = self.octaves_per_minute / 60.0
+        return 2 * np.pi * (self.f_start * (2.0 ** (k * te) - 1) / (k * np.log(2)) + self.f_end * (t - te))
+
+    def envelope(self, t):
+        """C2-smooth ramp 10s^3 - 15s^4 + 6s^5 over t_ramp, then 1."""
+        if self.t_ramp <= 0:
+            return 1.0 + 0 * t
+        xp = _ops(t)
+        s = xp.minimum(t / self.t_ramp, 1.0)
+        return s**3 * (10 - 15 * s + 6 * s**2)
+
+    def __call__(self, t):
+        """The signal at time(s) t (numpy array or CasADi expression)."""
+        if self.kind == 0:
+            return 0 * t
+        xp = _ops(t)
+        a = self.amplitude * self.envelope(t)
+        if self.kind >= 4:
+            a = a / (2 * np.pi * self.frequency(t))
+        return a * xp.sin(self.phase(t))
+
+
+class _Casadi:
+    minimum = staticmethod(ca.fmin)
+    sin = staticmethod(ca.sin)
+
+
+def _ops(t):
+    return _Casadi if isinstance(t, (ca.SX, ca.MX)) else np
+
+
+def multisine(n_samples: int, fs: float, f_min: float, f_max: float, rms: float, seed: int = 0) -> np.ndarray:
+    """One period of a random-phase multisine with flat amplitude spectrum on [f_min, f_max] Hz, scaled to rms.
+
+    Periodic with n_samples per period, so a whole number of periods is leakage-free.
+    """
+    rng = np.random.default_rng(seed)
+    spec = np.zeros(n_samples // 2 + 1, complex)
+    f = np.fft.rfftfreq(n_samples, 1 / fs)
+    band = (f >= f_min) & (f <= f_max) & (f > 0)
+    if not band.any():
+        raise ValueError(f"no frequency line of a {n_samples}-sample period at {fs} Hz lies in [{f_min}, {f_max}]")
+    spec[band] = np.exp(2j * np.pi * rng.random(band.sum()))
+    u = np.fft.irfft(spec, n_samples)
+    return u * rms / np.sqrt(np.mean(u**2))
