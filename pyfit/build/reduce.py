@@ -5,10 +5,12 @@ pymoca does no index reduction, so connections leave aliases and constraints bet
 
 1. eliminates every equation that is affine in exactly one unknown (unknowns are the derivatives
    of states and the algebraic variables), and pure aliases a = +-b between two unknowns;
-2. treats an equation left with no unknown as a constraint g(x, u, t) = 0 between states: the last
-   declared state in it is demoted to an algebraic variable (determined by g) and the differentiated
+2. treats an equation left with no unknown as a constraint g(x, u, t) = 0 between states: one state in
+   it is demoted to an algebraic variable (determined by g) and the differentiated
    constraint dg/dt = 0 is added (derivatives of inputs come from the model's __pyfit(inputDerivatives)
-   annotation, derivatives of time functions are exact);
+   annotation, derivatives of time functions are exact). pymoca does not read StateSelect, so the
+   choice is: demote a state whose derivative is not a state (a relative coordinate) before the
+   position of a mass, and among equals the last declared;
 3. repeats 1-2 until neither applies, then solves the remaining coupled equations block by block
    (block lower triangular order); each block must be affine in its unknowns.
 
@@ -172,6 +174,11 @@ class _Reducer:
         # eliminate plain algebraic variables before state derivatives, deeper (more local) names first
         return (name.startswith("der("), -name.count("."), name)
 
+    def _keep_priority(self, state: str) -> int:
+        """1 if der(state) is another kept state (a position whose velocity is a state), else 0."""
+        d = self.solution.get(self.der_name[state])
+        return int(d is not None and d.is_symbolic() and d.name() in self.states)
+
     def _try_constraint(self) -> bool:
         for i, e in enumerate(self.eqs):
             names = self._names_in(e)
@@ -181,8 +188,9 @@ class _Reducer:
             if not states:
                 raise ModelicaError(
                     f"{self.flat.name}: equation '{e}' involves no unknown: the model is overdetermined")
-            # demote the last declared state that the constraint can determine (affine, non-zero)
-            for var in reversed(states):
+            # demote a state that the constraint can determine (affine, non-zero): first one whose derivative
+            # is not itself a state (a relative coordinate rather than a mass's position), last declared first
+            for var in sorted(reversed(states), key=self._keep_priority):
                 coef = ca.jacobian(e, self.sym[var])
                 if not _is_zero(coef) and not ca.depends_on(coef, self.sym[var]):
                     break

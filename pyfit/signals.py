@@ -1,0 +1,144 @@
+"""Signal analysis for hysteretic systems (design section 3): PSD, FRF, loops, power, metrics.
+
+Every function takes samples on a uniform time grid; `assert_uniform` checks it before spectra.
+Units follow the signals (SI); PSDs are one-sided in unit^2/Hz.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.signal
+
+
+def assert_uniform(t: np.ndarray, rtol: float = 1e-9) -> float:
+    """Return the sample period [s] of t, or raise ValueError if the grid is not uniform."""
+    t = np.asarray(t, float)
+    if t.ndim != 1 or len(t) < 2:
+        raise ValueError("time column must be a 1-D array with at least two samples")
+    dt = np.diff(t)
+    if not np.all(np.isfinite(t)) or np.any(dt <= 0) or np.max(np.abs(dt - dt.mean())) > rtol * dt.mean() + 1e-12:
+        raise ValueError(f"time column is not uniformly sampled (steps from {dt.min():.6g} to {dt.max():.6g} s)")
+    return float(dt.mean())
+
+
+def welch_psd(y: np.ndarray, fs: float, segment_s: float | None = None, overlap: float = 0.5):
+    """Welch PSD with a Hann window; segment length segment_s [s] (default: the whole record / 8), overlap 50 %.
+
+    Returns (f [Hz], PSD [unit^2/Hz]); its integral over f equals the variance of y (Parseval).
+    """
+    y = np.asarray(y, float)
+    nper = len(y) // 8 if segment_s is None else int(round(segment_s * fs))
+    nper = max(16, min(nper, len(y)))
+    return scipy.signal.welch(y, fs=fs, window="hann", nperseg=nper, noverlap=int(overlap * nper), detrend=False)
+
+
+def psd_peak(y: np.ndarray, fs: float, segment_s: float | None = None) -> tuple[float, float]:
+    """Frequency [Hz] and value of the largest PSD bin (parabolic interpolation between bins)."""
+    f, p = welch_psd(y, fs, segment_s)
+    i = int(np.argmax(p[1:]) + 1)
+    if 0 < i < len(p) - 1:
+        a, b, c = np.log(p[i - 1:i + 2] + 1e-300)
+        shift = 0.5 * (a - c) / (a - 2 * b + c) if (a - 2 * b + c) != 0 else 0.0
+        return float(f[i] + shift * (f[1] - f[0])), float(p[i])
+    return float(f[i]), float(p[i])
+
+
+def frf_h1(u: np.ndarray, y: np.ndarray, fs: float, segment_s: float | None = None):
+    """H1 estimate of the frequency response y/u: (f [Hz], H = S_uy / S_uu, coherence)."""
+    nper = len(u) // 8 if segment_s is None else int(round(segment_s * fs))
+    f, suu = scipy.signal.welch(u, fs=fs, window="hann", nperseg=nper, detrend=False)
+    _, suy = scipy.signal.csd(u, y, fs=fs, window="hann", nperseg=nper, detrend=False)
+    _, coh = scipy.signal.coherence(u, y, fs=fs, window="hann", nperseg=nper, detrend=False)
+    return f, suy / suu, coh
+
+
+def frf_periodic(u: np.ndarray, y: np.ndarray, fs: float, period_samples: int):
+    """Leakage-free FRF from whole periods of a periodic excitation (steady state): Y(f)/U(f) at excited lines.
+
+    The last whole periods are averaged; returns (f [Hz], H) for lines where |U| is above 1e-6 of its maximum.
+    """
+    n_per = len(u) // period_samples
+    if n_per < 1:
+        raise ValueError("record shorter than one period")
+    uu = np.asarray(u[-n_per * period_samples:]).reshape(n_per, period_samples).mean(0)
+    yy = np.asarray(y[-n_per * period_samples:]).reshape(n_per, period_samples).mean(0)
+    U, Y = np.fft.rfft(uu), np.fft.rfft(yy)
+    f = np.fft.rfftfreq(period_samples, 1 / fs)
+    lines = np.abs(U) > 1e-6 * np.max(np.abs(U))
+    lines[0] = False
+    return f[lines], Y[lines] / U[lines]
+
+
+def transmissibility(base: np.ndarray, response: np.ndarray, fs: float, segment_s: float | None = None):
+    """|response / base| from H1 (e.g. mass acceleration over clamp acceleration): (f, |T|)."""
+    f, h, _ = frf_h1(base, response, fs, segment_s)
+    return f, np.abs(h)
+
+
+def spectrogram(y: np.ndarray, fs: float, segment_s: float = 1.0, overlap: float = 0.75):
+    """(f [Hz], t [s], PSD [unit^2/Hz]) with a Hann window."""
+    nper = int(round(segment_s * fs))
+    return scipy.signal.spectrogram(y, fs=fs, window="hann", nperseg=nper, noverlap=int(overlap * nper))
+
+
+def instantaneous_frequency(y: np.ndarray, fs: float) -> np.ndarray:
+    """Instantaneous frequency [Hz] from the phase of the analytic signal (Hilbert transform)."""
+    phase = np.unwrap(np.angle(scipy.signal.hilbert(y - np.mean(y))))
+    return np.gradient(phase) * fs / (2 * np.pi)
+
+
+def loop_area(x: np.ndarray, f: np.ndarray) -> float:
+    """Area of a closed loop in the (x, f) plane = the work of f over one cycle, integral f dx (shoelace)."""
+    x = np.append(x, x[0])
+    f = np.append(f, f[0])
+    return float(0.5 * np.sum((f[1:] + f[:-1]) * (x[1:] - x[:-1])))
+
+
+def last_periods(t: np.ndarray, signals: dict, frequency: float, periods: int = 1) -> dict:
+    """The last whole `periods` periods of each signal (for steady-state loops); samples per period must be whole."""
+    dt = assert_uniform(t)
+    n = int(round(periods / frequency / dt))
+    if abs(n * dt * frequency - periods) > 1e-6:
+        raise ValueError(f"{periods} period(s) at {frequency} Hz are not a whole number of samples of {dt} s")
+    return {k: np.asarray(v)[-n:] for k, v in signals.items()}
+
+
+@dataclass
+class SteadyCycle:
+    """Steady-state quantities of one excitation frequency."""
+
+    frequency: float  # Hz
+    dissipated_energy: float  # J per cycle, loop area
+    mean_power: float  # W, mean(F*v)
+    impedance: float  # N*s/m, |F| / |v| at the excitation frequency
+
+
+def steady_cycle(t, force, velocity, displacement, frequency) -> SteadyCycle:
+    """Energy per cycle (loop area of force vs displacement), mean power and impedance at one frequency."""
+    last = last_periods(t, {"F": force, "v": velocity, "x": displacement}, frequency)
+    n = len(last["F"])
+    k = 1  # one period: the fundamental is bin 1
+    F1 = np.fft.rfft(last["F"])[k]
+    V1 = np.fft.rfft(last["v"])[k]
+    return SteadyCycle(frequency, loop_area(last["x"], last["F"]), float(np.mean(last["F"] * last["v"])),
+                       float(np.abs(F1) / np.abs(V1)) if n > 2 else float("nan"))
+
+
+def nrmse(y_ref: np.ndarray, y: np.ndarray) -> float:
+    """RMS(y - y_ref) / std(y_ref)."""
+    y_ref, y = np.asarray(y_ref), np.asarray(y)
+    return float(np.sqrt(np.mean((y - y_ref) ** 2)) / np.std(y_ref))
+
+
+def rms_db(err: np.ndarray) -> float:
+    """20*log10(RMS(err)) in dB re one unit of err."""
+    return float(20 * np.log10(np.sqrt(np.mean(np.asarray(err) ** 2))))
+
+
+def band_psd_error(f: np.ndarray, psd: np.ndarray, psd_ref: np.ndarray, band: tuple[float, float]) -> np.ndarray:
+    """The seed's error vector on a band: (PSD - PSD_ref)/PSD_ref at the bins inside band [Hz]."""
+    sel = (f >= band[0]) & (f <= band[1])
+    if not sel.any():
+        raise ValueError(f"no PSD bin in band {band} Hz")
+    return (psd[sel] - psd_ref[sel]) / psd_ref[sel]
