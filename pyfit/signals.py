@@ -56,7 +56,8 @@ def frf_h1(u: np.ndarray, y: np.ndarray, fs: float, segment_s: float | None = No
 def frf_periodic(u: np.ndarray, y: np.ndarray, fs: float, period_samples: int):
     """Leakage-free FRF from whole periods of a periodic excitation (steady state): Y(f)/U(f) at excited lines.
 
-    The last whole periods are averaged; returns (f [Hz], H) for lines where |U| is above 1e-6 of its maximum.
+    All whole periods at the end of the record are averaged: pass steady-state samples only. Returns
+    (f [Hz], H) for the lines where |U| is above 1e-6 of its maximum.
     """
     n_per = len(u) // period_samples
     if n_per < 1:

@@ -1,0 +1,71 @@
+"""Analysis functions against analytic results, and steady-state energy checks on the FMUs."""
+import numpy as np
+import pytest
+
+from pyfit import signals
+from pyfit.excitation import multisine
+
+
+def test_psd_of_a_sine_peaks_at_its_frequency_and_integrates_to_its_variance():
+    fs, f0, amp = 1000.0, 37.3, 2.5
+    t = np.arange(200_000) / fs
+    y = amp * np.sin(2 * np.pi * f0 * t + 0.3)
+    f, p = signals.welch_psd(y, fs, segment_s=8.0)
+    peak, _ = signals.psd_peak(y, fs, segment_s=8.0)
+    assert peak == pytest.approx(f0, abs=f[1] - f[0])
+    assert np.trapezoid(p, f) == pytest.approx(np.var(y), rel=0.01)  # Parseval: amp^2/2
+
+
+def test_uniform_grid_is_asserted():
+    with pytest.raises(ValueError, match="not uniformly sampled"):
+        signals.assert_uniform(np.array([0.0, 0.1, 0.25, 0.3]))
+
+
+def test_frf_of_linear_two_dof_matches_analytic(runner):
+    # TwoDOF (a) with the Bouc-Wen element linearised (beta = 0: z = alpha*y2), whole-period multisine
+    fs, n = 1000.0, 2000
+    u = multisine(n, fs, 2.0, 40.0, 5.0, seed=3)
+    periods = 6
+    uu = np.append(np.tile(u, periods), u[0])
+    t = np.arange(len(uu)) / fs
+    res = runner("TwoDOFa").simulate(t[-1], 1 / fs, ["y1"], {"beta": 0.0, "exc_type": 0}, inputs={"f": uu},
+                                     input_time=t, tolerance=1e-11)
+    assert res.ok
+    steady = slice(3 * n, periods * n)  # the first periods carry the transient
+    f, H = signals.frf_periodic(uu[steady], res["y1"][steady], fs, n)
+    M = np.diag([0.5, 1.0])
+    K = np.array([[2500.0, -500.0], [-500.0, 5500.0 + 500.0]])
+    C = np.array([[6.0, -1.0], [-1.0, 3.0]])
+    w = 2 * np.pi * f
+    H_ref = np.array([np.linalg.solve(-wi**2 * M + 1j * wi * C + K, [1.0, 0.0])[0] for wi in w])
+    # the input is linear between samples: compare away from anti-resonances (|H| not tiny)
+    ok = np.abs(H_ref) > 0.2 * np.median(np.abs(H_ref))
+    assert ok.sum() > 0.8 * len(f)
+    assert np.max(np.abs(H[ok] - H_ref[ok]) / np.abs(H_ref[ok])) < 0.01
+
+
+def test_loop_area_equals_dissipated_energy_per_cycle(runner):
+    f_exc = 5.0
+    outputs = ["y", "v", "z", "F"]
+    res = runner("SDOFBoucWen").simulate(4.0, 1e-4, outputs, {"exc_type": 1, "exc_f_start": f_exc,
+                                                             "exc_amplitude": 120.0}, tolerance=1e-10)
+    last = signals.last_periods(res.time, {o: res[o] for o in outputs}, f_exc)
+    area = signals.loop_area(last["y"], last["F"])  # input work per cycle, integral F dy
+    dt = 1e-4
+    viscous = np.sum(10.0 * last["v"] ** 2) * dt
+    hysteretic = signals.loop_area(last["y"], last["z"])
+    assert hysteretic > 0.1 * area
+    assert area == pytest.approx(viscous + hysteretic, rel=0.02)
+
+
+def test_damper_power_at_constant_velocity_is_positive_and_equals_loop_area(runner):
+    outputs = ["F_clamp", "v_clamp", "x_clamp"]
+    for f_exc in (8.0, 10.0, 16.0, 20.0, 25.0):  # whole samples per period at 1e-4 s
+        res = runner("StockbridgeDamper").simulate(
+            6.0, 1e-4, outputs, {"exc_type": 1, "exc_f_start": f_exc, "exc_amplitude": 0.05 / (2 * np.pi * f_exc),
+                                 "exc_t_ramp": 0.5}, tolerance=1e-10)
+        assert res.ok
+        cyc = signals.steady_cycle(res.time, res["F_clamp"], res["v_clamp"], res["x_clamp"], f_exc)
+        assert cyc.mean_power > 0
+        assert cyc.dissipated_energy * f_exc == pytest.approx(cyc.mean_power, rel=0.02)
+        assert cyc.impedance > 0
