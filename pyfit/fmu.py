@@ -14,13 +14,28 @@ import shutil
 from dataclasses import dataclass, field
 
 import numpy as np
-from fmpy import extract, read_model_description
+from fmpy import calloc, extract, free, read_model_description
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import FMU2Model, FMU2Slave
+from fmpy.fmi2 import (FMU2Model, FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                       fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
 
 
 class ParameterError(ValueError):
     """A parameter name or value the FMU does not accept."""
+
+
+def _collecting_callbacks(log: list[str]) -> fmi2CallbackFunctions:
+    """FMI callbacks whose logger keeps the FMU's messages (the wrapper sends plain text)."""
+
+    def logger(env, instance, status, category, message):
+        log.append(message.decode("utf-8", "replace"))
+        del log[:-20]
+
+    cb = fmi2CallbackFunctions()
+    cb.logger = fmi2CallbackLoggerTYPE(logger)
+    cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    return cb
 
 
 @dataclass
@@ -72,8 +87,10 @@ class FmuRunner:
             cls = FMU2Slave if self.interface == "CoSimulation" else FMU2Model
             ident = (md.coSimulation if self.interface == "CoSimulation" else md.modelExchange).modelIdentifier
             fmu = cls(guid=md.guid, unzipDirectory=unzip, modelIdentifier=ident, instanceName="pyfit")
-            fmu.instantiate()
-            self._state.update(fmu=fmu, unzip=unzip)
+            log: list[str] = []
+            callbacks = _collecting_callbacks(log)
+            fmu.instantiate(callbacks=callbacks)
+            self._state.update(fmu=fmu, unzip=unzip, log=log, callbacks=callbacks)
         return self._state["fmu"]
 
     def close(self):
@@ -140,14 +157,17 @@ class FmuRunner:
         time = start_time + output_interval * np.arange(n + 1)
         try:
             fmu = self._instance()
+            self._state["log"].clear()
             fmu.reset()
             if self.interface == "CoSimulation":
                 vals = self._run_cs(fmu, time, outputs, params, inputs, input_time, tolerance)
             else:
                 vals = self._run_me(fmu, time, outputs, params, inputs, input_time, tolerance)
         except (FMICallException, OSError, RuntimeError) as exc:
-            self._state.pop("fmu", None)  # the instance may be unusable: make a fresh one next time
-            return SimulationResult(time, {o: np.full(len(time), np.nan) for o in outputs}, False, str(exc))
+            log = self._state.get("log", [])
+            message = "; ".join(log[-2:] + [str(exc)]) if log else str(exc)
+            self.close()  # the instance may be unusable: make a fresh one next time
+            return SimulationResult(time, {o: np.full(len(time), np.nan) for o in outputs}, False, message)
         dt = np.diff(time)
         assert np.allclose(dt, output_interval, rtol=1e-9, atol=0), "output grid is not uniform"
         return SimulationResult(time, vals)

@@ -60,14 +60,21 @@ typedef struct {
 } Instance;
 
 static void logmsg(Instance *c, fmi2Status st, const char *fmt, ...) {
-  char buf[1024];
+  char buf[1024], out[2048];
+  size_t i, j = 0;
   va_list ap;
   if (!c || !c->cb || !c->cb->logger) return;
   if (st == fmi2OK && !c->logging) return;
   va_start(ap, fmt);
   vsnprintf(buf, sizeof buf, fmt, ap);
   va_end(ap);
-  c->cb->logger(c->cb->componentEnvironment, c->name, st, st == fmi2OK ? "logAll" : "logStatusError", "%s", buf);
+  /* the logger's message is a format string: pass the text with '%' escaped, and no arguments */
+  for (i = 0; buf[i] && j + 2 < sizeof out; i++) {
+    if (buf[i] == '%') out[j++] = '%';
+    out[j++] = buf[i];
+  }
+  out[j] = '\0';
+  c->cb->logger(c->cb->componentEnvironment, c->name, st, st == fmi2OK ? "logAll" : "logStatusError", out);
 }
 
 /* ---- calls into the generated functions ----------------------------------------------------- */

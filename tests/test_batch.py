@@ -1,0 +1,71 @@
+"""Batch runs: serial, process pool and Dask give identical results; failures stay local; no leaks."""
+import os
+
+import numpy as np
+import pytest
+
+from pyfit.batch import RunSpec, run_batch, run_one
+from pyfit.fmu import FmuRunner
+
+
+def _sweep_specs(fmu):
+    return [RunSpec(str(fmu), 1.0, 1e-3, ("y", "z"), {"exc_type": 1, "exc_f_start": f, "exc_amplitude": a},
+                    label=f"{f}Hz_{a}N")
+            for f in (5.0, 15.0, 30.0, 45.0) for a in (30.0, 60.0, 90.0, 120.0)]
+
+
+def test_serial_pool_and_dask_give_identical_results(fmu_dir):
+    from distributed import Client, LocalCluster
+
+    specs = _sweep_specs(fmu_dir / "SDOFBoucWen.fmu")
+    assert len(specs) == 16
+    serial = run_batch(specs, workers=1, progress=False)
+    pool = run_batch(specs, workers=2, progress=False)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        dask = run_batch(specs, scheduler=client, progress=False)
+    for a, b, c in zip(serial, pool, dask):
+        assert a.ok and b.ok and c.ok
+        for o in ("y", "z"):
+            np.testing.assert_array_equal(a[o], b[o])
+            np.testing.assert_array_equal(a[o], c[o])
+    # the runs differ from each other (a real sweep, not one result repeated)
+    assert len({round(float(np.max(np.abs(r["y"]))), 12) for r in serial}) == 16
+
+
+def test_one_failing_run_does_not_stop_the_batch(fmu_dir, tmp_path):
+    good = _sweep_specs(fmu_dir / "SDOFBoucWen.fmu")[:3]
+    bad_param = RunSpec(str(fmu_dir / "SDOFBoucWen.fmu"), 1.0, 1e-3, ("y",), {"no_such_parameter": 1.0})
+    missing = RunSpec(str(tmp_path / "missing.fmu"), 1.0, 1e-3, ("y",))
+    # a diverging run: negative damping makes the oscillator grow like exp(500 t) until it overflows
+    diverging = RunSpec(str(fmu_dir / "SDOFBoucWen.fmu"), 3.0, 1e-3, ("y",), {"c": -2000.0, "alpha": 0.0})
+    res = run_batch(good + [bad_param, missing, diverging], workers=2, progress=False)
+    assert all(r.ok for r in res[:3])
+    assert not res[3].ok and "no_such_parameter" in res[3].message and "valid parameters" in res[3].message
+    assert not res[4].ok and "missing.fmu" in res[4].message
+    assert not res[5].ok and "diverged" in res[5].message
+
+
+def _rss_bytes():
+    with open(f"/proc/{os.getpid()}/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def test_three_hundred_reset_runs_in_one_process_without_memory_growth(fmu_dir):
+    # short CI version of bench/fmu_soak.py (1000 runs)
+    runner = FmuRunner(str(fmu_dir / "SDOFBoucWen.fmu"))
+    rss = []
+    for i in range(300):
+        r = runner.simulate(0.05, 1e-3, ["y"], {"exc_type": 1, "exc_f_start": 10.0 + i % 7})
+        assert r.ok
+        if i == 99:
+            rss.append(_rss_bytes())
+    rss.append(_rss_bytes())
+    runner.close()
+    assert rss[1] <= 1.05 * rss[0], rss
+
+
+def test_run_one_reuses_the_instance(fmu_dir):
+    spec = _sweep_specs(fmu_dir / "SDOFBoucWen.fmu")[0]
+    a, b = run_one(spec), run_one(spec)
+    np.testing.assert_array_equal(a["y"], b["y"])
