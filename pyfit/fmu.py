@@ -66,6 +66,8 @@ class FmuRunner:
     @property
     def model_description(self):
         if "md" not in self._state:
+            if not pathlib.Path(self.path).is_file():
+                raise FileNotFoundError(f"{self.path}: FMU file not found")
             self._state["md"] = read_model_description(self.path)
         return self._state["md"]
 
@@ -125,6 +127,25 @@ class FmuRunner:
                 raise ParameterError(f"{pathlib.Path(self.path).name}: parameter '{name}' = {value} outside "
                                      f"[{lo}, {hi}]")
 
+    def _check_inputs(self, inputs: dict, input_time) -> None:
+        """Input samples must be finite and on one uniform, increasing time column."""
+        from .signals import assert_uniform
+
+        if input_time is None:
+            raise ValueError("inputs given without input_time")
+        try:
+            assert_uniform(input_time)
+        except ValueError as exc:
+            raise ValueError(f"input time column: {exc}") from exc
+        for name, values in inputs.items():
+            values = np.asarray(values, float)
+            if values.shape != np.shape(input_time):
+                raise ValueError(f"input '{name}' has {values.shape} samples, its time column {np.shape(input_time)}")
+            bad = np.flatnonzero(~np.isfinite(values))
+            if bad.size:
+                raise ValueError(f"input '{name}' is not finite at {bad.size} sample(s), first at "
+                                 f"t = {input_time[bad[0]]:g} s")
+
     def _apply(self, fmu, params: dict):
         for name, value in params.items():
             v = self.variables[name]
@@ -150,6 +171,8 @@ class FmuRunner:
         for name in outputs + list(inputs or {}):
             if name not in self.variables:
                 raise ParameterError(f"{pathlib.Path(self.path).name}: no variable '{name}'")
+        if inputs:
+            self._check_inputs(inputs, input_time)
         n = int(round((stop_time - start_time) / output_interval))
         if n < 1 or abs(start_time + n * output_interval - stop_time) > 1e-9 * max(1.0, abs(stop_time)):
             raise ValueError(f"stop_time - start_time = {stop_time - start_time} is not a whole number of "

@@ -1,0 +1,172 @@
+"""TOML study files -> validated dataclasses. Every error names the file, the key and what is allowed."""
+from __future__ import annotations
+
+import pathlib
+import tomllib
+from dataclasses import dataclass, field
+
+from .build import EXAMPLES
+
+EXCITATION_KINDS = {"sine": 1, "linear_sweep": 2, "log_sweep": 3, "cv_linear_sweep": 4, "cv_log_sweep": 5}
+
+
+class ConfigError(ValueError):
+    """A study file that cannot be used; the message names file, key and the allowed values."""
+
+
+@dataclass
+class ExcitationConfig:
+    """Built-in excitation of every run; levels are amplitudes (N, m, or m/s for the cv_ kinds)."""
+
+    kind: str
+    levels: list[float]
+    frequencies: list[float] = field(default_factory=list)  # sine: one run per frequency [Hz]
+    f_start: float = 0.0
+    f_end: float = 60.0
+    rate: float = 0.5  # Hz/s
+    octaves_per_minute: float = 1.0
+    t_ramp: float = 0.0
+    loops_at: list[float] = field(default_factory=list)  # sweeps: frequencies [Hz] at which to cut loops
+
+    @property
+    def exc_type(self) -> int:
+        return EXCITATION_KINDS[self.kind]
+
+
+@dataclass
+class ParameterSet:
+    name: str
+    values: dict[str, float]
+
+
+@dataclass
+class SweepConfig:
+    """A sweep study: models x parameter sets x excitation levels (x sine frequencies)."""
+
+    path: pathlib.Path
+    models: list[str]
+    stop_time: float
+    output_interval: float
+    outputs: dict[str, list[str]]  # model -> output names
+    excitation: ExcitationConfig
+    parameters: dict[str, float]
+    parameter_sets: list[ParameterSet]
+    tolerance: float = 1e-8
+    title: str = ""
+
+
+def _fail(path, key, problem, allowed=None):
+    msg = f"{path}: [{key}] {problem}"
+    if allowed is not None:
+        msg += f"; allowed: {allowed}"
+    raise ConfigError(msg)
+
+
+def _take(table: dict, path, section: str, spec: dict):
+    """Check a TOML table against spec {key: (type, required, default)}; return the values."""
+    unknown = set(table) - set(spec)
+    if unknown:
+        _fail(path, f"{section}.{sorted(unknown)[0]}", "unknown key", ", ".join(sorted(spec)))
+    out = {}
+    for key, (typ, required, default) in spec.items():
+        if key not in table:
+            if required:
+                _fail(path, f"{section}.{key}", "missing")
+            out[key] = default
+            continue
+        value = table[key]
+        if typ is float and isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        if typ == "floats":
+            if not isinstance(value, list) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                      for v in value):
+                _fail(path, f"{section}.{key}", f"must be a list of numbers, not {value!r}")
+            value = [float(v) for v in value]
+        elif typ == "strings":
+            if isinstance(value, str):
+                value = [value]
+            if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+                _fail(path, f"{section}.{key}", f"must be a string or a list of strings, not {value!r}")
+        elif not isinstance(value, typ):
+            _fail(path, f"{section}.{key}", f"must be {typ.__name__}, not {value!r}")
+        out[key] = value
+    return out
+
+
+def _numbers(table, path, section):
+    for k, v in table.items():
+        if not isinstance(v, (int, float)) or isinstance(v, bool):
+            _fail(path, f"{section}.{k}", f"must be a number, not {v!r}")
+    return {k: float(v) for k, v in table.items()}
+
+
+def load_sweep(path: str | pathlib.Path, fmu_variables=None) -> SweepConfig:
+    """Read and validate a sweep study file.
+
+    fmu_variables(model) -> an object with .parameters (names that can be set), .variables (all names)
+    and .outputs (the FMU's outputs, the default); used to reject unknown names.
+    """
+    path = pathlib.Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: file not found")
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML: {exc}") from exc
+    top = set(doc) - {"study", "excitation", "parameters", "parameter_sets"}
+    if top:
+        _fail(path, sorted(top)[0], "unknown section", "study, excitation, parameters, parameter_sets")
+    if "study" not in doc:
+        _fail(path, "study", "missing section")
+    if "excitation" not in doc:
+        _fail(path, "excitation", "missing section")
+    st = _take(doc["study"], path, "study", {
+        "models": ("strings", True, None), "stop_time": (float, True, None), "output_interval": (float, False, 1e-3),
+        "outputs": ("strings", False, None), "tolerance": (float, False, 1e-8), "title": (str, False, "")})
+    for m in st["models"]:
+        if m not in EXAMPLES:
+            _fail(path, "study.models", f"unknown model '{m}'", ", ".join(EXAMPLES))
+    if st["stop_time"] <= 0 or st["output_interval"] <= 0 or st["output_interval"] > st["stop_time"]:
+        _fail(path, "study.stop_time", "stop_time and output_interval must be > 0 with output_interval <= stop_time")
+    if abs(round(st["stop_time"] / st["output_interval"]) * st["output_interval"] - st["stop_time"]) > 1e-9:
+        _fail(path, "study.output_interval", "stop_time must be a whole number of output intervals")
+    ex = _take(doc["excitation"], path, "excitation", {
+        "kind": (str, True, None), "levels": ("floats", True, None), "frequencies": ("floats", False, []),
+        "f_start": (float, False, 0.0), "f_end": (float, False, 60.0), "rate": (float, False, 0.5),
+        "octaves_per_minute": (float, False, 1.0), "t_ramp": (float, False, 0.0), "loops_at": ("floats", False, [])})
+    if ex["kind"] not in EXCITATION_KINDS:
+        _fail(path, "excitation.kind", f"unknown kind '{ex['kind']}'", ", ".join(EXCITATION_KINDS))
+    if not ex["levels"]:
+        _fail(path, "excitation.levels", "needs at least one level")
+    if ex["kind"] == "sine" and not ex["frequencies"]:
+        _fail(path, "excitation.frequencies", "a sine study needs at least one frequency [Hz]")
+    if ex["kind"] != "sine" and (ex["f_end"] <= ex["f_start"] or ex["rate"] <= 0):
+        _fail(path, "excitation.f_end", "a sweep needs f_end > f_start and rate > 0")
+    if ex["kind"] in ("log_sweep", "cv_linear_sweep", "cv_log_sweep") and ex["f_start"] <= 0:
+        _fail(path, "excitation.f_start", "log and constant-velocity sweeps need f_start > 0")
+    excitation = ExcitationConfig(**ex)
+    parameters = _numbers(doc.get("parameters", {}), path, "parameters")
+    sets = []
+    for i, s in enumerate(doc.get("parameter_sets", [{"name": "default"}])):
+        if "name" not in s or not isinstance(s["name"], str):
+            _fail(path, f"parameter_sets[{i}].name", "missing (a string)")
+        sets.append(ParameterSet(s["name"], _numbers({k: v for k, v in s.items() if k != "name"}, path,
+                                                     f"parameter_sets[{i}]")))
+    if len({s.name for s in sets}) != len(sets):
+        _fail(path, "parameter_sets", "names must be unique")
+    outputs = {}
+    for m in st["models"]:
+        outputs[m] = st["outputs"] or []
+        if fmu_variables is None:
+            continue
+        iface = fmu_variables(m)
+        for name in list(parameters) + [k for s in sets for k in s.values]:
+            if name not in iface.parameters:
+                _fail(path, "parameters", f"model {m} has no parameter '{name}'", ", ".join(sorted(iface.parameters)))
+        for o in outputs[m]:
+            if o not in iface.variables:
+                _fail(path, "study.outputs", f"model {m} has no variable '{o}'", ", ".join(iface.outputs))
+        outputs[m] = outputs[m] or list(iface.outputs)
+    return SweepConfig(path, st["models"], st["stop_time"], st["output_interval"], outputs, excitation, parameters,
+                       sets, st["tolerance"], st["title"])
+
