@@ -47,6 +47,7 @@ def loops(path, panels: list[tuple[str, list[tuple[str, np.ndarray, np.ndarray]]
         for legend, x, f in curves:
             ax.plot(x, f, lw=0.9, label=legend)
         ax.set_title(ptitle, fontsize=9)
+        ax.ticklabel_format(style="sci", scilimits=(-2, 3))
         ax.set_xlabel(_label(x_name, units))
         ax.set_ylabel(_label(f_name, units))
         if len(curves) > 1:
