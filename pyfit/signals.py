@@ -126,6 +126,37 @@ def steady_cycle(t, force, velocity, displacement, frequency) -> SteadyCycle:
                        float(np.abs(F1) / np.abs(V1)) if n > 2 else float("nan"))
 
 
+def sweep_power_impedance(t, force, velocity, phase, frequency, at_hz, cycles: int = 8):
+    """Dissipated power [W] and impedance [N*s/m] along a slow sweep (IEC 61897 / IEEE 664 quantities).
+
+    phase(t) [rad] and frequency(t) [Hz] describe the excitation (pyfit.excitation.Excitation). Around
+    the time the sweep passes each frequency of at_hz, a window of `cycles` excitation periods gives
+    the mean of F*v and the ratio of the fundamental amplitudes |F1|/|V1| (least squares on the
+    excitation's sine and cosine). Returns two arrays aligned with at_hz (NaN where the sweep does not
+    reach a frequency).
+    """
+    t = np.asarray(t, float)
+    assert_uniform(t)
+    f_t = frequency(t)
+    power = np.full(len(at_hz), np.nan)
+    impedance = np.full(len(at_hz), np.nan)
+    for k, f0 in enumerate(at_hz):
+        hit = np.nonzero(f_t >= f0)[0]
+        if not len(hit) or f0 <= 0:
+            continue
+        half = cycles / f0 / 2
+        sel = (t >= t[hit[0]] - half) & (t <= t[hit[0]] + half)
+        if t[hit[0]] - half < t[0] or t[hit[0]] + half > t[-1]:
+            continue
+        th = phase(t[sel])
+        basis = np.column_stack([np.sin(th), np.cos(th), np.ones(sel.sum())])
+        cf = np.linalg.lstsq(basis, force[sel], rcond=None)[0]
+        cv = np.linalg.lstsq(basis, velocity[sel], rcond=None)[0]
+        power[k] = float(np.mean(force[sel] * velocity[sel]))
+        impedance[k] = float(np.hypot(*cf[:2]) / np.hypot(*cv[:2]))
+    return power, impedance
+
+
 def nrmse(y_ref: np.ndarray, y: np.ndarray) -> float:
     """RMS(y - y_ref) / std(y_ref)."""
     y_ref, y = np.asarray(y_ref), np.asarray(y)

@@ -37,8 +37,8 @@ def test_one_failing_run_does_not_stop_the_batch(fmu_dir, tmp_path):
     good = _sweep_specs(fmu_dir / "SDOFBoucWen.fmu")[:3]
     bad_param = RunSpec(str(fmu_dir / "SDOFBoucWen.fmu"), 1.0, 1e-3, ("y",), {"no_such_parameter": 1.0})
     missing = RunSpec(str(tmp_path / "missing.fmu"), 1.0, 1e-3, ("y",))
-    # a diverging run: negative damping makes the oscillator grow like exp(500 t) until it overflows
-    diverging = RunSpec(str(fmu_dir / "SDOFBoucWen.fmu"), 3.0, 1e-3, ("y",), {"c": -2000.0, "alpha": 0.0})
+    # a diverging run: a negative stiffness makes the mass run away like exp(316 t) until it overflows
+    diverging = RunSpec(str(fmu_dir / "SDOFBoucWen.fmu"), 3.0, 1e-3, ("y",), {"k": -2e5, "alpha": 0.0})
     res = run_batch(good + [bad_param, missing, diverging], workers=2, progress=False)
     assert all(r.ok for r in res[:3])
     assert not res[3].ok and "no_such_parameter" in res[3].message and "valid parameters" in res[3].message

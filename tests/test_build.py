@@ -87,3 +87,10 @@ def test_semantic_error_builds_nothing(tmp_path):
     with pytest.raises(ModelicaError, match="not balanced: 62 equations for 59 unknowns"):
         build_all(out, ["TwoDOFa"], library=lib)
     assert not out.exists() or not list(out.glob("*.fmu"))
+
+
+def test_out_of_range_parameter_is_rejected_with_its_range(runner):
+    with pytest.raises(ParameterError, match=r"'m' = -1.0 outside \[0.0, inf\]"):
+        runner("SDOFBoucWen").simulate(0.1, 1e-3, ["y"], {"m": -1.0})
+    with pytest.raises(ParameterError, match=r"'a_bw' = 1.5 outside \[0.0, 1.0\]"):
+        runner("StockbridgeDamper").simulate(0.1, 1e-3, ["x1"], {"a_bw": 1.5})

@@ -69,3 +69,24 @@ def test_damper_power_at_constant_velocity_is_positive_and_equals_loop_area(runn
         assert cyc.mean_power > 0
         assert cyc.dissipated_energy * f_exc == pytest.approx(cyc.mean_power, rel=0.02)
         assert cyc.impedance > 0
+
+
+def test_damper_power_and_impedance_from_a_slow_sweep_match_stepped_sines(runner):
+    from pyfit.excitation import Excitation
+
+    v0, rate = 0.03, 0.25
+    exc = Excitation(4, v0, 5.0, 30.0, rate, t_ramp=1.0)
+    damper = runner("StockbridgeDamper")
+    sweep = damper.simulate(100.0, 1e-3, ["F_clamp", "v_clamp"], {
+        "exc_type": 4, "exc_v0": v0, "exc_f_start": 5.0, "exc_f_end": 30.0, "exc_rate": rate, "exc_t_ramp": 1.0})
+    at = [12.5, 20.0, 25.0]  # away from the resonances, where a slow sweep is quasi-steady
+    power, impedance = signals.sweep_power_impedance(sweep.time, sweep["F_clamp"], sweep["v_clamp"], exc.phase,
+                                                     exc.frequency, at)
+    for f, p, z in zip(at, power, impedance):
+        res = damper.simulate(5.0, 1e-4, ["F_clamp", "v_clamp", "x_clamp"], {
+            "exc_type": 1, "exc_f_start": f, "exc_amplitude": v0 / (2 * np.pi * f), "exc_t_ramp": 0.5},
+            tolerance=1e-10)
+        cyc = signals.steady_cycle(res.time, res["F_clamp"], res["v_clamp"], res["x_clamp"], f)
+        assert p > 0
+        assert p == pytest.approx(cyc.mean_power, rel=0.05)
+        assert z == pytest.approx(cyc.impedance, rel=0.03)

@@ -32,6 +32,8 @@ class FmuVariable:
     description: str
     settable: int  # 0 no, 1 parameter (before init), 2 input, 3 state start value (before init)
     derivative_of: int | None = None  # vr of the state
+    minimum: float = float("-inf")
+    maximum: float = float("inf")
 
 
 def layout(model: ExplicitModel) -> list[FmuVariable]:
@@ -41,7 +43,9 @@ def layout(model: ExplicitModel) -> list[FmuVariable]:
     def add(v, causality, variability, initial, start, settable, vtype="Real", name=None, unit=None, desc=None):
         out.append(FmuVariable(name or v.name, len(out), vtype, causality, variability, initial, start,
                                unit if unit is not None else v.unit,
-                               desc if desc is not None else v.description, settable))
+                               desc if desc is not None else v.description, settable,
+                               minimum=v.minimum if name is None else float("-inf"),
+                               maximum=v.maximum if name is None else float("inf")))
 
     for v in model.parameters:
         vtype = "Integer" if v.python_type is int else "Real"
@@ -176,6 +180,9 @@ def model_description(model: ExplicitModel, ident: str, guid: str, variables: li
                 tattrs["unit"] = v.unit
             if v.derivative_of is not None:
                 tattrs["derivative"] = str(v.derivative_of + 1)
+        for key, bound in (("min", v.minimum), ("max", v.maximum)):
+            if math.isfinite(bound):
+                tattrs[key] = str(int(bound)) if v.type == "Integer" else _fmt(bound)
         if v.start is not None:
             tattrs["start"] = str(int(v.start)) if v.type == "Integer" else _fmt(v.start)
         ET.SubElement(sv, v.type, tattrs)

@@ -38,6 +38,7 @@ class Variable:
     python_type: type = float
     is_output: bool = False
     minimum: float = float("-inf")
+    maximum: float = float("inf")
 
 
 @dataclass
@@ -135,7 +136,7 @@ def load(library: pathlib.Path, model_name: str) -> FlatModel:
                 description=descriptions.get(name, ""),
                 start=float(start) if isinstance(start, (int, float)) else 0.0,
                 value=v.value, python_type=v.python_type, is_output=name in outputs,
-                minimum=float(getattr(v, "min", float("-inf"))) if isinstance(getattr(v, "min", None), (int, float)) else float("-inf")))
+                minimum=_bound(v, "min", float("-inf")), maximum=_bound(v, "max", float("inf"))))
     der_symbols = {s.symbol.name(): d.symbol for s, d in zip(model.states, model.der_states)}
     if model.initial_equations:
         raise ModelicaError(f"{model_name}: initial equations are not supported; give start values")
@@ -153,6 +154,12 @@ def load(library: pathlib.Path, model_name: str) -> FlatModel:
     experiment = {k: float(v) for k, v in (annotation.get("experiment") or {}).items()}
     return FlatModel(model_name, original.comment or "", variables, der_symbols, equations, model.time,
                      experiment, input_derivatives)
+
+
+def _bound(v, attr: str, default: float) -> float:
+    """A numeric min/max attribute of a pymoca variable, or the default when absent or symbolic."""
+    value = getattr(v, attr, None)
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else default
 
 
 def _fix_self_references(variables: list[Variable], model_name: str) -> None:
