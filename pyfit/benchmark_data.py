@@ -4,6 +4,7 @@ Used for validation and reporting only, never for estimation (see shared/data/bo
 """
 from __future__ import annotations
 
+import os
 import pathlib
 from dataclasses import dataclass
 
@@ -12,7 +13,9 @@ import scipy.interpolate
 import scipy.io
 
 FS_HZ = 750.0  # sampling frequency of the official signals (not stored in the files)
-DEFAULT_DIR = pathlib.Path(__file__).resolve().parents[2] / "shared" / "data" / "boucwen"
+# ../shared/data/boucwen beside the repository, or the folder named by BOUCWEN_DATA_DIR
+DEFAULT_DIR = pathlib.Path(os.environ.get("BOUCWEN_DATA_DIR")
+                           or pathlib.Path(__file__).resolve().parents[2] / "shared" / "data" / "boucwen")
 
 
 @dataclass

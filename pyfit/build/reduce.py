@@ -73,9 +73,7 @@ class _Reducer:
         self.sym = dict(zip(self.names, sx_syms))
 
         to_sx = ca.Function("to_sx", mx_syms, flat.equations, {"allow_free": True})
-        self.eqs: list[ca.SX] = list(to_sx(*sx_syms)) if flat.equations else []
-        if len(flat.equations) == 1:
-            self.eqs = [to_sx(*sx_syms)]
+        self.eqs: list[ca.SX] = to_sx.call(sx_syms) if flat.equations else []
         # parameter values (numbers or expressions of other parameters) in SX
         self.param_value: dict[str, object] = {}
         for v in flat.variables:
@@ -248,7 +246,6 @@ class _Reducer:
             for k, v in enumerate(vars_):
                 self._eliminate(v, ca.simplify(sol[k]))
                 sol = ca.substitute(sol, self.sym[v], self.solution[v])
-            self.eqs = list(self.eqs)  # already substituted in _eliminate
         self.eqs = []
 
     def result(self) -> ExplicitModel:
