@@ -63,12 +63,19 @@ def simulate_cvodes(model: ReferenceModel, t: np.ndarray, params: dict | None = 
     u_of_t = u0 + slope * tau + _input_expr(model, excitation, tk + tau)
     ode = ca.substitute(model.rhs, ca.vertcat(model.u, model.t), ca.vertcat(u_of_t, tk + tau))
     dae = {"x": model.x, "p": ca.vertcat(model.p, u0, slope, tk), "t": tau, "ode": ode}
-    step = ca.integrator("step", "cvodes", dae, 0.0, h, {"reltol": rtol, "abstol": atol, "max_num_steps": 100000})
+    opts = {"reltol": rtol, "abstol": atol, "max_num_steps": 100000}
     n = len(t) - 1
-    P = np.vstack([np.repeat(p[:, None], n, 1), U[:, :-1], np.diff(U, axis=1) / h, t[None, :-1]])
-    run = step.mapaccum("run", n, ["x0"], ["xf"])
     xs = np.zeros(model.x.numel()) if x0 is None else np.asarray(x0, float)
-    X = np.hstack([xs[:, None], np.array(run(x0=xs, p=P)["xf"])])
+    if not np.any(U):
+        # no sampled input: one integration over the whole grid (the excitation is a function of time)
+        whole = ca.integrator("whole", "cvodes", dae, 0.0, t[1:] - t[0], opts)
+        P = np.concatenate([p, np.zeros(2 * model.u.numel()), [t[0]]])
+        X = np.hstack([xs[:, None], np.array(whole(x0=xs, p=P)["xf"])])
+    else:
+        step = ca.integrator("step", "cvodes", dae, 0.0, h, opts)
+        P = np.vstack([np.repeat(p[:, None], n, 1), U[:, :-1], np.diff(U, axis=1) / h, t[None, :-1]])
+        run = step.mapaccum("run", n, ["x0"], ["xf"])
+        X = np.hstack([xs[:, None], np.array(run(x0=xs, p=P)["xf"])])
     U_total = U + np.array(ca.Function("ue", [model.t], [_input_expr(model, excitation, model.t)]).map(len(t))(t[None, :]))
     return _outputs(model, X, U_total, p, t)
 

@@ -1,0 +1,154 @@
+"""The fitting objective: FMU simulation of an experiment -> residual vector against a measurement.
+
+kind 'psd_band': the seed's errorVec (design section 3), (PSD_sim - PSD_meas)/PSD_meas on each channel's
+bands, both from identical Welch settings, times sqrt(weight). kind 'time': (y_sim - y_meas)/std(y_meas)
+after a warm-up. Parameters enter scaled to [0, 1] within their bounds. A failed or diverging
+simulation gives a finite penalty vector and is recorded; nothing non-finite leaves this module.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import signals
+from .data import Measurement
+from .fmu import FmuRunner
+
+
+@dataclass
+class FreeParameter:
+    """A parameter being fitted, with its bounds in SI units."""
+
+    name: str
+    lower: float
+    upper: float
+
+    def value(self, u: float) -> float:
+        return self.lower + float(u) * (self.upper - self.lower)
+
+    def unit(self, value: float) -> float:
+        return (value - self.lower) / (self.upper - self.lower)
+
+
+@dataclass
+class ObjectiveChannel:
+    """One compared signal: FMU output, measured column, PSD bands [Hz] and weight."""
+
+    output: str
+    column: str
+    bands: list[tuple[float, float]] = field(default_factory=list)
+    weight: float = 1.0
+
+
+@dataclass
+class Evaluation:
+    """One true (FMU) evaluation."""
+
+    x: list[float]
+    error: float
+    ok: bool
+    message: str
+    wall_s: float
+
+
+class Objective:
+    """Residual vector r(x) of unit-scaled parameters x; error = sum(r^2)."""
+
+    def __init__(self, fmu: str, measurement: Measurement, variables: list[FreeParameter],
+                 channels: list[ObjectiveChannel], fixed: dict | None = None, kind: str = "psd_band",
+                 segment_s: float = 8.0, warmup_s: float = 0.0, tolerance: float = 1e-8, penalty: float = 10.0,
+                 use_inputs: bool = False):
+        if kind not in ("psd_band", "time"):
+            raise ValueError(f"objective kind '{kind}' unknown; allowed: psd_band, time")
+        self.runner = FmuRunner(fmu)
+        self.m = measurement
+        self.variables = variables
+        self.channels = channels
+        self.fixed = dict(fixed or {})
+        self.kind = kind
+        self.segment_s = segment_s
+        self.tolerance = tolerance
+        self.penalty = penalty
+        self.use_inputs = use_inputs
+        self.fs = measurement.sample_rate_hz
+        self.t = measurement.t - measurement.t[0]
+        self.first = int(round(warmup_s * self.fs))
+        self.evaluations: list[Evaluation] = []
+        self._target = {}
+        for ch in channels:
+            if ch.column not in measurement.values:
+                raise ValueError(f"{measurement.path}: no column '{ch.column}'; columns: "
+                                 f"{', '.join(measurement.values)}")
+            y = measurement.values[ch.column][self.first:]
+            if kind == "psd_band":
+                f, p = signals.welch_psd(y, self.fs, segment_s)
+                masks = [(f >= lo) & (f <= hi) for lo, hi in ch.bands]
+                if not ch.bands or not all(m.any() for m in masks):
+                    raise ValueError(f"channel {ch.output}: every band needs at least one PSD bin "
+                                     f"(resolution {f[1] - f[0]:.4g} Hz)")
+                self._target[ch.output] = (p, np.any(masks, axis=0))
+            else:
+                self._target[ch.output] = (y, float(np.std(y)))
+        if kind == "psd_band":
+            self.size = sum(int(mask.sum()) for _, mask in self._target.values())
+        else:
+            self.size = sum(len(y) for y, _ in self._target.values())
+
+    def params(self, x) -> dict:
+        """FMU parameters (SI) for unit-scaled x."""
+        p = dict(self.fixed)
+        p.update({v.name: v.value(u) for v, u in zip(self.variables, np.clip(x, 0.0, 1.0))})
+        return p
+
+    def simulate(self, x, outputs=None):
+        """The FMU's response on the measurement's time grid."""
+        inputs = None
+        if self.use_inputs:
+            inputs = {ch.model_variable: self.m.values[c] for c, ch in self.m.inputs.items()}
+        return self.runner.simulate(self.t[-1], 1.0 / self.fs, outputs or [c.output for c in self.channels],
+                                    self.params(x), inputs=inputs, input_time=self.t if inputs else None,
+                                    tolerance=self.tolerance)
+
+    def residuals(self, x) -> np.ndarray:
+        """Residual vector (finite; the penalty vector when the simulation fails)."""
+        t0 = time.perf_counter()
+        res = self.simulate(x)
+        parts = []
+        ok, message = res.ok, res.message
+        if ok:
+            for ch in self.channels:
+                y = res[ch.output][self.first:]
+                target, aux = self._target[ch.output]
+                if self.kind == "psd_band":
+                    _, p = signals.welch_psd(y, self.fs, self.segment_s)
+                    r = (p[aux] - target[aux]) / target[aux]
+                else:
+                    r = (y - target) / aux
+                parts.append(np.sqrt(ch.weight) * r)
+            r = np.concatenate(parts)
+            if not np.all(np.isfinite(r)):
+                ok, message = False, "non-finite residual"
+        if not ok:
+            r = np.full(self.size, self.penalty)
+        err = float(np.sum(r**2))
+        self.evaluations.append(Evaluation([float(v) for v in x], err, ok, message, time.perf_counter() - t0))
+        return r
+
+    def __call__(self, x) -> float:
+        return float(np.sum(self.residuals(x) ** 2))
+
+    def band_error_percent(self, x) -> dict[str, float]:
+        """The seed's '% error' per channel: RMS over the band bins of (PSD - PSD_meas)/PSD_meas, in %."""
+        res = self.simulate(x)
+        out = {}
+        for ch in self.channels:
+            f, p = signals.welch_psd(res[ch.output][self.first:], self.fs, self.segment_s)
+            _, pm = signals.welch_psd(self.m.values[ch.column][self.first:], self.fs, self.segment_s)
+            mask = np.any([(f >= lo) & (f <= hi) for lo, hi in ch.bands], axis=0)
+            out[ch.output] = float(100 * np.sqrt(np.mean(((p[mask] - pm[mask]) / pm[mask]) ** 2)))
+        return out
+
+    def close(self):
+        self.runner.close()
