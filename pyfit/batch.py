@@ -7,7 +7,9 @@ SimulationResult(ok=False) with the reason; the other runs of the batch go on.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import multiprocessing
 import os
+import sys
 import pathlib
 from dataclasses import dataclass, field
 
@@ -57,38 +59,45 @@ def _progress(total, enabled, desc):
     return tqdm(total=total, disable=not enabled, desc=desc, unit="run")
 
 
-def run_batch(specs: list[RunSpec], workers: int | None = None, scheduler: str | None = None,
-              progress: bool = True, desc: str = "simulations") -> list[SimulationResult]:
-    """Results in the order of specs.
-
-    workers=1: serial in this process; workers=None: one process per core; scheduler='tcp://host:port'
-    (or a distributed.Client / LocalCluster address): the same runs on a Dask cluster.
-    """
-    specs = list(specs)
-    results: list[SimulationResult | None] = [None] * len(specs)
-    bar = _progress(len(specs), progress and len(specs) > 1, desc)
+def map_tasks(fn, items: list, workers: int | None = None, scheduler=None, progress: bool = True,
+              desc: str = "tasks") -> list:
+    """fn(item) for every item, results in order: serially (workers=1), on a local process pool
+    (workers=None: one per core), or on a Dask cluster (scheduler address or distributed.Client).
+    fn must be picklable (a module-level function) and should not raise."""
+    items = list(items)
+    results: list = [None] * len(items)
+    bar = _progress(len(items), progress and len(items) > 1, desc)
     try:
         if scheduler is not None:
             from distributed import Client, as_completed
 
             client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
-            futures = {client.submit(run_one, s, pure=False): i for i, s in enumerate(specs)}
+            futures = {client.submit(fn, it, pure=False): i for i, it in enumerate(items)}
             for fut in as_completed(futures):
                 results[futures[fut]] = fut.result()
                 bar.update()
             if client is not scheduler:
                 client.close()
-        elif workers == 1 or len(specs) == 1:
-            for i, s in enumerate(specs):
-                results[i] = run_one(s)
+        elif workers == 1 or len(items) == 1:
+            for i, it in enumerate(items):
+                results[i] = fn(it)
                 bar.update()
         else:
-            n = workers or os.cpu_count() or 1
-            with cf.ProcessPoolExecutor(max_workers=n) as pool:
-                futures = {pool.submit(run_one, s): i for i, s in enumerate(specs)}
+            # forkserver: workers fork from a clean server process, never from this one, whose threads
+            # (torch, BLAS) could be holding locks at the moment of a fork
+            method = "forkserver" if sys.platform.startswith("linux") else "spawn"
+            ctx = multiprocessing.get_context(method)
+            with cf.ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1, mp_context=ctx) as pool:
+                futures = {pool.submit(fn, it): i for i, it in enumerate(items)}
                 for fut in cf.as_completed(futures):
                     results[futures[fut]] = fut.result()
                     bar.update()
     finally:
         bar.close()
-    return results  # type: ignore[return-value]
+    return results
+
+
+def run_batch(specs: list[RunSpec], workers: int | None = None, scheduler=None, progress: bool = True,
+              desc: str = "simulations") -> list[SimulationResult]:
+    """Simulate every spec (see map_tasks for workers and scheduler); results in the order of specs."""
+    return map_tasks(run_one, specs, workers, scheduler, progress, desc)

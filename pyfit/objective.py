@@ -1,8 +1,9 @@
 """The fitting objective: FMU simulation of an experiment -> residual vector against a measurement.
 
 kind 'psd_band': the seed's errorVec (design section 3), (PSD_sim - PSD_meas)/PSD_meas on each channel's
-bands, both from identical Welch settings, times sqrt(weight). kind 'time': (y_sim - y_meas)/std(y_meas)
-after a warm-up. Parameters enter scaled to [0, 1] within their bounds. A failed or diverging
+bands, both from identical Welch settings, times sqrt(weight). kind 'psd_log': log(PSD_sim/PSD_meas) on
+the same bins (equal to the relative error near the optimum, but bounded where a resonance is far off,
+which a surrogate learns more easily). kind 'time': (y_sim - y_meas)/std(y_meas) after a warm-up. Parameters enter scaled to [0, 1] within their bounds. A failed or diverging
 simulation gives a finite penalty vector and is recorded; nothing non-finite leaves this module.
 """
 from __future__ import annotations
@@ -60,8 +61,8 @@ class Objective:
                  channels: list[ObjectiveChannel], fixed: dict | None = None, kind: str = "psd_band",
                  segment_s: float = 8.0, warmup_s: float = 0.0, tolerance: float = 1e-8, penalty: float = 10.0,
                  use_inputs: bool = False):
-        if kind not in ("psd_band", "time"):
-            raise ValueError(f"objective kind '{kind}' unknown; allowed: psd_band, time")
+        if kind not in ("psd_band", "psd_log", "time"):
+            raise ValueError(f"objective kind '{kind}' unknown; allowed: psd_band, psd_log, time")
         self.runner = FmuRunner(fmu)
         self.m = measurement
         self.variables = variables
@@ -82,7 +83,7 @@ class Objective:
                 raise ValueError(f"{measurement.path}: no column '{ch.column}'; columns: "
                                  f"{', '.join(measurement.values)}")
             y = measurement.values[ch.column][self.first:]
-            if kind == "psd_band":
+            if kind != "time":
                 f, p = signals.welch_psd(y, self.fs, segment_s)
                 masks = [(f >= lo) & (f <= hi) for lo, hi in ch.bands]
                 if not ch.bands or not all(m.any() for m in masks):
@@ -91,7 +92,7 @@ class Objective:
                 self._target[ch.output] = (p, np.any(masks, axis=0))
             else:
                 self._target[ch.output] = (y, float(np.std(y)))
-        if kind == "psd_band":
+        if kind != "time":
             self.size = sum(int(mask.sum()) for _, mask in self._target.values())
         else:
             self.size = sum(len(y) for y, _ in self._target.values())
@@ -124,6 +125,9 @@ class Objective:
                 if self.kind == "psd_band":
                     _, p = signals.welch_psd(y, self.fs, self.segment_s)
                     r = (p[aux] - target[aux]) / target[aux]
+                elif self.kind == "psd_log":
+                    _, p = signals.welch_psd(y, self.fs, self.segment_s)
+                    r = np.log(np.maximum(p[aux], 1e-300) / target[aux])
                 else:
                     r = (y - target) / aux
                 parts.append(np.sqrt(ch.weight) * r)

@@ -9,6 +9,7 @@ latest true error < fun_tol, or when the relative change of x < x_tol and of the
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -58,7 +59,9 @@ class _SurrogateProblem(Problem):
 
 def sobol_points(n: int, d: int, seed: int) -> np.ndarray:
     """n scrambled Sobol points in [0, 1]^d (space-filling initial design)."""
-    return qmc.Sobol(d, scramble=True, seed=seed).random(n)
+    with warnings.catch_warnings():  # any n is fine for a design; powers of two only balance better
+        warnings.simplefilter("ignore", UserWarning)
+        return qmc.Sobol(d, scramble=True, seed=seed).random(n)
 
 
 def nno(residuals, n_var: int, settings: NNOSettings, x0: np.ndarray | None = None, callback=None) -> OptimResult:

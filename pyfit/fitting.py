@@ -1,0 +1,155 @@
+"""One fitting run: target measurement -> objective -> optimiser -> result.json and figures."""
+from __future__ import annotations
+
+import hashlib
+import json
+import pathlib
+import time
+from dataclasses import asdict
+
+import numpy as np
+
+from . import __version__, plots, signals
+from .data import read_measurement
+from .fit_config import FitConfig
+from .objective import Objective
+from .optim import baselines
+from .optim.nno import nno
+from .run_example import ensure_fmu
+from .synthetic import SyntheticSpec, write_synthetic
+
+
+def ensure_target(cfg: FitConfig) -> pathlib.Path:
+    """The target measurement, made from [target.synthetic] (CasADi reference + sensor chain) if missing."""
+    if cfg.target_file.is_file():
+        return cfg.target_file
+    if cfg.synthetic is None:
+        raise FileNotFoundError(f"{cfg.path}: [target.file] {cfg.target_file} not found")
+    s = cfg.synthetic
+    spec = SyntheticSpec(cfg.model, s["excitation"], s["stop_time"], s["sample_rate_hz"], s["outputs"],
+                         s["parameters"], s["noise_std"], s["oversample"], s["seed"])
+    tmp = cfg.target_file.with_name(cfg.target_file.stem + ".partial.csv")
+    write_synthetic(tmp, spec)
+    tmp.with_suffix(".toml").replace(cfg.target_file.with_suffix(".toml"))
+    tmp.replace(cfg.target_file)
+    return cfg.target_file
+
+
+def _versions() -> dict:
+    import casadi
+    import fmpy
+    import pymoo
+    import scipy
+    import torch
+
+    return {"pyfit": __version__, "fmpy": fmpy.__version__, "torch": torch.__version__, "casadi": casadi.__version__,
+            "numpy": np.__version__, "scipy": scipy.__version__, "pymoo": pymoo.__version__}
+
+
+def _objective(cfg: FitConfig, fmu, measurement, kind: str) -> Objective:
+    return Objective(str(fmu), measurement, cfg.variables, cfg.channels, cfg.fixed, kind, cfg.segment_s,
+                     cfg.warmup_s, cfg.tolerance, cfg.penalty, cfg.use_inputs)
+
+
+def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: int) -> dict:
+    """Fit with cfg's method and the given seed; write result.json and figures into out_dir; return the result."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    fmu = ensure_fmu(cfg.model, fmu_dir)
+    measurement = read_measurement(cfg.target_file)
+    obj = _objective(cfg, fmu, measurement, cfg.objective_kind)
+    n = len(cfg.variables)
+    history, ann = [], []
+    settings = cfg.nno
+    settings.seed = seed
+    if cfg.method in ("nno", "nno+polish"):
+        res = nno(obj.residuals, n, settings)
+        ann = [h for h in res.history if h.get("ann_error") is not None]
+    elif cfg.method == "ga":
+        res, _ = baselines.ga_direct(obj.residuals, n, cfg.budget, cfg.ga_pop_size, seed)
+    elif cfg.method == "de":
+        res = baselines.differential_evolution(obj.residuals, n, cfg.budget, seed)
+    else:
+        res = baselines.polish(obj.residuals, np.full(n, 0.5), cfg.budget)
+    history = [dict(h, stage="global") for h in res.history]
+    best_x, n_eval, stop = res.x, res.n_evaluations, res.stop_reason
+    if cfg.method == "nno+polish":
+        pobj = obj if cfg.polish_kind == cfg.objective_kind else _objective(cfg, fmu, measurement, cfg.polish_kind)
+        pol = baselines.polish(pobj.residuals, best_x, cfg.polish_budget)
+        history += [dict(h, stage="polish", evaluations=h["evaluations"] + n_eval) for h in pol.history]
+        best_x, n_eval, stop = pol.x, n_eval + pol.n_evaluations, f"{stop}+polish:{pol.stop_reason}"
+        final_obj = pobj
+    else:
+        final_obj = obj
+    error = float(np.sum(obj.residuals(best_x) ** 2))
+    ident = baselines.identifiability(final_obj.residuals, best_x, cfg.variables)
+    params = obj.params(best_x)
+    fitted = {v.name: params[v.name] for v in cfg.variables}
+    result = {
+        "config": str(cfg.path), "config_text": cfg.path.read_text(), "model": cfg.model, "method": cfg.method,
+        "seed": seed, "parameters": fitted, "x_unit": [float(v) for v in best_x], "objective": error,
+        "band_error_percent": obj.band_error_percent(best_x) if cfg.objective_kind != "time" else {},
+        "true_evaluations": int(n_eval), "stop_reason": stop, "wall_s": time.perf_counter() - t0,
+        "identifiability": asdict(ident), "recovery": recovery(fitted, cfg), "history": history,
+        "versions": _versions(), "fmu_sha256": hashlib.sha256(pathlib.Path(fmu).read_bytes()).hexdigest(),
+        "target": str(cfg.target_file),
+    }
+    (out_dir / "result.json").write_text(json.dumps(result, indent=1, default=float))
+    _figures(cfg, obj, best_x, history, ann, out_dir)
+    obj.close()
+    return result
+
+
+def recovery(fitted: dict, cfg: FitConfig) -> dict:
+    """Relative errors against a known truth (synthetic targets), also for identifiable products."""
+    if not cfg.truth:
+        return {}
+    vals = dict(cfg.truth, **fitted)
+    out = {k: (fitted[k] - cfg.truth[k]) / cfg.truth[k] for k in fitted if k in cfg.truth and cfg.truth[k]}
+    for a, b in cfg.products:
+        if a in vals and b in vals and a in cfg.truth and b in cfg.truth:
+            true = cfg.truth[a] * cfg.truth[b]
+            out[f"{a}*{b}"] = (vals[a] * vals[b] - true) / true
+    return out
+
+
+def _figures(cfg, obj: Objective, x, history, ann, out_dir):
+    import matplotlib.pyplot as plt
+
+    ev = [h["evaluations"] for h in history]
+    err = [h["true_error"] for h in history]
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    ax.semilogy(ev, err, ".", ms=4, label="true (FMU) error")
+    ax.semilogy(ev, np.minimum.accumulate(err), "-", label="best so far")
+    if ann:
+        ax.semilogy([h["evaluations"] for h in ann], [max(h["ann_error"], 1e-300) for h in ann], "x", ms=4,
+                    label="ANN-predicted error at the GA optimum")
+    ax.set_xlabel("true evaluations [-]")
+    ax.set_ylabel("objective sum(r²) [-]")
+    ax.legend(fontsize=8)
+    ax.set_title(f"{cfg.path.stem}: convergence ({cfg.method})")
+    plots._save(fig, out_dir / "convergence.png")
+    res = obj.simulate(x)
+    fs = obj.fs
+    units = {c.output: "m" for c in cfg.channels}
+    for ch in cfg.channels:
+        meas = obj.m.values[ch.column]
+        curves = [("measured", meas, fs), ("fitted model", res[ch.output], fs)]
+        plots.psd_overlay(out_dir / f"psd_{ch.output}.png", curves, ch.output, units, f"{cfg.path.stem}: PSD",
+                          cfg.segment_s)
+        if ch.bands:
+            lo = min(b[0] for b in ch.bands)
+            hi = max(b[1] for b in ch.bands)
+            fig, ax = plt.subplots(figsize=(7, 3.5))
+            for label, y in (("measured", meas), ("fitted model", res[ch.output])):
+                f, p = signals.welch_psd(y, fs, cfg.segment_s)
+                sel = (f >= lo) & (f <= hi)
+                ax.semilogy(f[sel], p[sel], label=label)
+            ax.set_xlabel("frequency [Hz]")
+            ax.set_ylabel(f"PSD of {ch.output} [{units[ch.output]}²/Hz]")
+            ax.legend(fontsize=8)
+            ax.set_title(f"{cfg.path.stem}: PSD in the bands")
+            plots._save(fig, out_dir / f"psd_band_{ch.output}.png")
+        plots.time_histories(out_dir / f"time_{ch.output}.png",
+                             [("measured", obj.t, {ch.output: meas}), ("fitted model", res.time, {ch.output: res[ch.output]})],
+                             [ch.output], units, f"{cfg.path.stem}: displacement")

@@ -1,0 +1,191 @@
+"""Fitting machinery: identifiability, surrogate, NNO, baselines, measurement files, fit configs, resume."""
+import json
+import shutil
+import textwrap
+
+import numpy as np
+import pytest
+
+from pyfit.config import ConfigError
+from pyfit.data import MeasurementError, read_measurement, write_measurement
+from pyfit.fit_batch import fit_batch
+from pyfit.fit_config import load_fit
+from pyfit.objective import FreeParameter
+from pyfit.optim import baselines
+from pyfit.optim.nno import NNOSettings, nno
+from pyfit.optim.surrogate import Surrogate
+from pyfit.sweep import fmu_interface
+
+
+def test_only_beta_gamma_and_beta_delta_are_identifiable(runner):
+    """(beta, gamma, delta) and (2 beta, gamma/2, delta/2) give the same response, bit for bit."""
+    base = {"exc_rate": 6.0}
+    a = runner("SDOFBoucWen").simulate(4.0, 1e-3, ["y", "z"], dict(base, beta=1000.0, gamma=0.8, delta=-1.1))
+    b = runner("SDOFBoucWen").simulate(4.0, 1e-3, ["y", "z"], dict(base, beta=2000.0, gamma=0.4, delta=-0.55))
+    c = runner("SDOFBoucWen").simulate(4.0, 1e-3, ["y", "z"], dict(base, beta=1000.0, gamma=0.4, delta=-0.55))
+    np.testing.assert_array_equal(a["y"], b["y"])
+    assert np.max(np.abs(a["y"] - c["y"])) > 1e-2 * np.max(np.abs(a["y"]))  # the products do matter
+
+
+def _linear_residuals(x):
+    """A residual vector whose least-squares optimum is known: x* = (0.3, 0.7, 0.55)."""
+    A = np.array([[1.0, 0.2, 0.0], [0.0, 1.0, -0.3], [0.4, 0.0, 1.0], [1.0, 1.0, 1.0]])
+    return A @ (np.asarray(x) - np.array([0.3, 0.7, 0.55]))
+
+
+def _curved_residuals(x):
+    x = np.asarray(x)
+    return np.array([10 * (x[1] - x[0] ** 2), 1 - x[0], 3 * (x[2] - 0.4)])  # optimum (1, 1, 0.4)
+
+
+def test_identifiability_finds_the_degenerate_pair():
+    vars_ = [FreeParameter("a", 0, 1), FreeParameter("b", 0, 1), FreeParameter("c", 0, 1)]
+    rng = np.random.default_rng(0)
+    noise = rng.normal(0, 0.01, 50)
+
+    def degenerate(x):  # depends on a and b only through a + b
+        t = np.linspace(0, 1, 50)
+        return (x[0] + x[1] - 0.8) * t + (x[2] - 0.5) * t**2 + noise
+
+    ident = baselines.identifiability(degenerate, np.array([0.3, 0.5, 0.5]), vars_)
+    assert ident.singular_values[-1] < 1e-6 * ident.singular_values[0]
+    ok = baselines.identifiability(_linear_residuals, np.array([0.3, 0.7, 0.55]), vars_, noise_var=1e-4)
+    assert ok.singular_values[-1] > 0.1
+    assert all(abs(s - 0.01 * e) < 0.02 for s, e in zip(ok.std, [1, 1, 1]))  # sigma (J^T J)^-1/2 ~ 0.01
+
+
+def test_surrogate_learns_a_smooth_vector_function():
+    rng = np.random.default_rng(1)
+    X = rng.random((80, 2))
+    R = np.column_stack([np.sin(3 * X[:, 0]) + X[:, 1], X[:, 0] * X[:, 1]])
+    s = Surrogate([20], seed=0).fit(X, R)
+    Xt = rng.random((50, 2))
+    Rt = np.column_stack([np.sin(3 * Xt[:, 0]) + Xt[:, 1], Xt[:, 0] * Xt[:, 1]])
+    assert np.sqrt(np.mean((s.predict(Xt) - Rt) ** 2)) < 0.05
+
+
+def test_nno_finds_the_optimum_returns_the_best_point_and_is_reproducible():
+    settings = NNOSettings(init_sim=10, max_sim=30, fun_tol=1e-6, p_size=20, ga_generations=40, seed=3)
+    a = nno(_linear_residuals, 3, settings)
+    b = nno(_linear_residuals, 3, settings)
+    assert [(h["x"], h["true_error"]) for h in a.history] == [(h["x"], h["true_error"]) for h in b.history]
+    assert a.error == min(h["true_error"] for h in a.history)  # best point ever evaluated
+    np.testing.assert_allclose(a.x, [0.3, 0.7, 0.55], atol=0.03)
+    assert a.n_evaluations <= 30 and a.stop_reason in ("fun_tol", "stall", "max_sim")
+
+
+def test_baselines_respect_the_budget_and_polish_converges():
+    de = baselines.differential_evolution(_curved_residuals, 3, budget=100, seed=0)
+    assert de.n_evaluations == 100 and de.stop_reason == "budget"
+    ga, reached = baselines.ga_direct(_curved_residuals, 3, budget=200, pop_size=20, seed=0, target=0.05)
+    assert ga.n_evaluations <= 200
+    if reached is not None:
+        assert ga.history[reached - 1]["true_error"] <= 0.05
+    pol = baselines.polish(_curved_residuals, np.array([0.8, 0.6, 0.6]), budget=200)
+    np.testing.assert_allclose(pol.x, [1.0, 1.0, 0.4], atol=1e-3)
+
+
+def test_measurement_round_trip_with_units(tmp_path):
+    t = np.arange(0, 1, 1e-3)
+    path = write_measurement(tmp_path / "m.csv", "StockbridgeDamper", t,
+                             {"acc": (np.sin(t) * 9.80665, "g", "a_base")},
+                             {"x1": (1e-3 * np.cos(t), "mm", "x1")}, level="v0=0.05 m/s", level_value=0.05)
+    m = read_measurement(path)
+    np.testing.assert_allclose(m.values["x1"], 1e-3 * np.cos(t), rtol=1e-9)
+    np.testing.assert_allclose(m.values["acc"], np.sin(t) * 9.80665, rtol=1e-9, atol=1e-12)
+    assert m.level_value == 0.05 and m.outputs["x1"].model_variable == "x1"
+
+
+@pytest.mark.parametrize("edit,needle", [
+    (lambda csv, side: csv.write_text(csv.read_text().replace("\n0.5,", "\nnan,", 1)), "column 't'"),
+    (lambda csv, side: side.write_text(side.read_text().replace("sample_rate_hz = 1000", "sample_rate_hz = 999")),
+     "[sample_rate_hz]"),
+    (lambda csv, side: side.write_text(side.read_text().replace('x1 = {', 'x9 = {')), "column 'x9'"),
+    (lambda csv, side: side.write_text(side.read_text().replace('unit = "mm"', 'unit = "furlong"')),
+     "[outputs.x1.unit] 'furlong' unknown"),
+])
+def test_bad_measurement_files_name_file_and_field(tmp_path, edit, needle):
+    t = np.arange(0, 1, 1e-3)
+    path = write_measurement(tmp_path / "m.csv", "X", t, {}, {"x1": (np.cos(t), "mm", "x1")})
+    lines = path.read_text().splitlines()
+    lines[501] = "0.5," + lines[501].split(",", 1)[1]
+    path.write_text("\n".join(lines) + "\n")
+    edit(path, path.with_suffix(".toml"))
+    with pytest.raises(MeasurementError) as err:
+        read_measurement(path)
+    assert needle in str(err.value) and "m." in str(err.value)
+
+
+TINY = """
+[fit]
+model = "SDOFBoucWen"
+method = "nno"
+budget = 8
+[target]
+file = "data/tiny.csv"
+[target.synthetic]
+excitation = { kind = 2, amplitude = 120.0, f_start = 20.0, f_end = 50.0, rate = 10.0 }
+stop_time = 3.0
+sample_rate_hz = 1000.0
+outputs = ["y"]
+noise_std = { y = 1e-6 }
+[experiment]
+exc_type = 2
+exc_amplitude = 120.0
+exc_f_start = 20.0
+exc_f_end = 50.0
+exc_rate = 10.0
+[objective]
+kind = "psd_log"
+segment_s = 1.0
+channels = [{ output = "y", column = "y_meas", bands = [[30.0, 42.0]] }]
+[variables]
+alpha = [40000.0, 60000.0]
+[nno]
+init_sim = 5
+ga_generations = 10
+[report]
+truth = { alpha = 50000.0 }
+"""
+
+
+def test_fit_batch_writes_results_and_resumes_without_redoing(tmp_path, fmu_dir):
+    cfg = tmp_path / "tiny.toml"
+    cfg.write_text(TINY)
+    out = tmp_path / "out"
+    first = fit_batch([cfg], repeats=2, out=out, fmu_dir=fmu_dir, workers=2, progress=False)
+    assert [r.get("error") for r in first] == [None, None]
+    files = sorted(out.glob("tiny/seed_*/result.json"))
+    assert len(files) == 2
+    r0 = json.loads(files[0].read_text())
+    assert r0["true_evaluations"] == 8 and len(r0["history"]) == 8
+    assert {"pyfit", "fmpy", "torch", "casadi"} <= set(r0["versions"]) and len(r0["fmu_sha256"]) == 64
+    assert (files[0].parent / "convergence.png").is_file() and (out / "summary.md").is_file()
+    stamp = files[0].stat().st_mtime_ns
+    shutil.rmtree(files[1].parent)  # as if the batch had been killed before the second run finished
+    second = fit_batch([cfg], repeats=2, out=out, fmu_dir=fmu_dir, workers=1, progress=False)
+    assert files[0].stat().st_mtime_ns == stamp  # the finished run was not redone
+    assert files[1].is_file() and len(second) == 2
+
+
+@pytest.mark.parametrize("change,key", [
+    (("budget = 8", "budget = 8\nspeed = 1"), "fit.speed"),
+    (("alpha = [40000.0, 60000.0]", "alpha = [60000.0, 40000.0]"), "variables.alpha"),
+    (("alpha = [40000.0, 60000.0]", "alfa = [40000.0, 60000.0]"), "variables"),
+    (('method = "nno"', 'method = "annealing"'), "fit.method"),
+    (('[target.synthetic]', '[target.unused]'), "target.unused"),
+])
+def test_bad_fit_config_names_file_and_key(tmp_path, fmu_dir, change, key):
+    cfg = tmp_path / "tiny.toml"
+    cfg.write_text(TINY.replace(*change))
+    with pytest.raises(ConfigError) as err:
+        load_fit(cfg, lambda m: fmu_interface(fmu_dir / f"{m}.fmu").parameters)
+    assert str(cfg) in str(err.value) and f"[{key}]" in str(err.value)
+
+
+def test_missing_target_file_is_named(tmp_path):
+    cfg = tmp_path / "tiny.toml"
+    text = TINY.split("[target.synthetic]")[0] + "[experiment]" + TINY.split("[experiment]")[1]
+    cfg.write_text(textwrap.dedent(text))
+    with pytest.raises(ConfigError, match=r"\[target.file\] measurement .*tiny.csv not found"):
+        load_fit(cfg)
