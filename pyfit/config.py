@@ -2,10 +2,10 @@
 from __future__ import annotations
 
 import pathlib
-import tomllib
 from dataclasses import dataclass, field
 
 from .build import EXAMPLES
+from .tomlfile import read_toml
 
 EXCITATION_KINDS = {"sine": 1, "linear_sweep": 2, "log_sweep": 3, "cv_linear_sweep": 4, "cv_log_sweep": 5}
 
@@ -55,23 +55,23 @@ class SweepConfig:
     title: str = ""
 
 
-def _fail(path, key, problem, allowed=None):
+def fail(path, key, problem, allowed=None):
     msg = f"{path}: [{key}] {problem}"
     if allowed is not None:
         msg += f"; allowed: {allowed}"
     raise ConfigError(msg)
 
 
-def _take(table: dict, path, section: str, spec: dict):
+def check_table(table: dict, path, section: str, spec: dict):
     """Check a TOML table against spec {key: (type, required, default)}; return the values."""
     unknown = set(table) - set(spec)
     if unknown:
-        _fail(path, f"{section}.{sorted(unknown)[0]}", "unknown key", ", ".join(sorted(spec)))
+        fail(path, f"{section}.{sorted(unknown)[0]}", "unknown key", ", ".join(sorted(spec)))
     out = {}
     for key, (typ, required, default) in spec.items():
         if key not in table:
             if required:
-                _fail(path, f"{section}.{key}", "missing")
+                fail(path, f"{section}.{key}", "missing")
             out[key] = default
             continue
         value = table[key]
@@ -80,23 +80,23 @@ def _take(table: dict, path, section: str, spec: dict):
         if typ == "floats":
             if not isinstance(value, list) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
                                                       for v in value):
-                _fail(path, f"{section}.{key}", f"must be a list of numbers, not {value!r}")
+                fail(path, f"{section}.{key}", f"must be a list of numbers, not {value!r}")
             value = [float(v) for v in value]
         elif typ == "strings":
             if isinstance(value, str):
                 value = [value]
             if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-                _fail(path, f"{section}.{key}", f"must be a string or a list of strings, not {value!r}")
+                fail(path, f"{section}.{key}", f"must be a string or a list of strings, not {value!r}")
         elif not isinstance(value, typ):
-            _fail(path, f"{section}.{key}", f"must be {typ.__name__}, not {value!r}")
+            fail(path, f"{section}.{key}", f"must be {typ.__name__}, not {value!r}")
         out[key] = value
     return out
 
 
-def _numbers(table, path, section):
+def check_numbers(table, path, section):
     for k, v in table.items():
         if not isinstance(v, (int, float)) or isinstance(v, bool):
-            _fail(path, f"{section}.{k}", f"must be a number, not {v!r}")
+            fail(path, f"{section}.{k}", f"must be a number, not {v!r}")
     return {k: float(v) for k, v in table.items()}
 
 
@@ -107,53 +107,48 @@ def load_sweep(path: str | pathlib.Path, fmu_variables=None) -> SweepConfig:
     and .outputs (the FMU's outputs, the default); used to reject unknown names.
     """
     path = pathlib.Path(path)
-    if not path.is_file():
-        raise ConfigError(f"{path}: file not found")
-    try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML: {exc}") from exc
+    doc = read_toml(path, ConfigError)
     top = set(doc) - {"study", "excitation", "parameters", "parameter_sets"}
     if top:
-        _fail(path, sorted(top)[0], "unknown section", "study, excitation, parameters, parameter_sets")
+        fail(path, sorted(top)[0], "unknown section", "study, excitation, parameters, parameter_sets")
     if "study" not in doc:
-        _fail(path, "study", "missing section")
+        fail(path, "study", "missing section")
     if "excitation" not in doc:
-        _fail(path, "excitation", "missing section")
-    st = _take(doc["study"], path, "study", {
+        fail(path, "excitation", "missing section")
+    st = check_table(doc["study"], path, "study", {
         "models": ("strings", True, None), "stop_time": (float, True, None), "output_interval": (float, False, 1e-3),
         "outputs": ("strings", False, None), "tolerance": (float, False, 1e-8), "title": (str, False, "")})
     for m in st["models"]:
         if m not in EXAMPLES:
-            _fail(path, "study.models", f"unknown model '{m}'", ", ".join(EXAMPLES))
+            fail(path, "study.models", f"unknown model '{m}'", ", ".join(EXAMPLES))
     if st["stop_time"] <= 0 or st["output_interval"] <= 0 or st["output_interval"] > st["stop_time"]:
-        _fail(path, "study.stop_time", "stop_time and output_interval must be > 0 with output_interval <= stop_time")
+        fail(path, "study.stop_time", "stop_time and output_interval must be > 0 with output_interval <= stop_time")
     if abs(round(st["stop_time"] / st["output_interval"]) * st["output_interval"] - st["stop_time"]) > 1e-9:
-        _fail(path, "study.output_interval", "stop_time must be a whole number of output intervals")
-    ex = _take(doc["excitation"], path, "excitation", {
+        fail(path, "study.output_interval", "stop_time must be a whole number of output intervals")
+    ex = check_table(doc["excitation"], path, "excitation", {
         "kind": (str, True, None), "levels": ("floats", True, None), "frequencies": ("floats", False, []),
         "f_start": (float, False, 0.0), "f_end": (float, False, 60.0), "rate": (float, False, 0.5),
         "octaves_per_minute": (float, False, 1.0), "t_ramp": (float, False, 0.0), "loops_at": ("floats", False, [])})
     if ex["kind"] not in EXCITATION_KINDS:
-        _fail(path, "excitation.kind", f"unknown kind '{ex['kind']}'", ", ".join(EXCITATION_KINDS))
+        fail(path, "excitation.kind", f"unknown kind '{ex['kind']}'", ", ".join(EXCITATION_KINDS))
     if not ex["levels"]:
-        _fail(path, "excitation.levels", "needs at least one level")
+        fail(path, "excitation.levels", "needs at least one level")
     if ex["kind"] == "sine" and not ex["frequencies"]:
-        _fail(path, "excitation.frequencies", "a sine study needs at least one frequency [Hz]")
+        fail(path, "excitation.frequencies", "a sine study needs at least one frequency [Hz]")
     if ex["kind"] != "sine" and (ex["f_end"] <= ex["f_start"] or ex["rate"] <= 0):
-        _fail(path, "excitation.f_end", "a sweep needs f_end > f_start and rate > 0")
+        fail(path, "excitation.f_end", "a sweep needs f_end > f_start and rate > 0")
     if ex["kind"] in ("log_sweep", "cv_linear_sweep", "cv_log_sweep") and ex["f_start"] <= 0:
-        _fail(path, "excitation.f_start", "log and constant-velocity sweeps need f_start > 0")
+        fail(path, "excitation.f_start", "log and constant-velocity sweeps need f_start > 0")
     excitation = ExcitationConfig(**ex)
-    parameters = _numbers(doc.get("parameters", {}), path, "parameters")
+    parameters = check_numbers(doc.get("parameters", {}), path, "parameters")
     sets = []
     for i, s in enumerate(doc.get("parameter_sets", [{"name": "default"}])):
         if "name" not in s or not isinstance(s["name"], str):
-            _fail(path, f"parameter_sets[{i}].name", "missing (a string)")
-        sets.append(ParameterSet(s["name"], _numbers({k: v for k, v in s.items() if k != "name"}, path,
+            fail(path, f"parameter_sets[{i}].name", "missing (a string)")
+        sets.append(ParameterSet(s["name"], check_numbers({k: v for k, v in s.items() if k != "name"}, path,
                                                      f"parameter_sets[{i}]")))
     if len({s.name for s in sets}) != len(sets):
-        _fail(path, "parameter_sets", "names must be unique")
+        fail(path, "parameter_sets", "names must be unique")
     outputs = {}
     for m in st["models"]:
         outputs[m] = st["outputs"] or []
@@ -162,10 +157,10 @@ def load_sweep(path: str | pathlib.Path, fmu_variables=None) -> SweepConfig:
         iface = fmu_variables(m)
         for name in list(parameters) + [k for s in sets for k in s.values]:
             if name not in iface.parameters:
-                _fail(path, "parameters", f"model {m} has no parameter '{name}'", ", ".join(sorted(iface.parameters)))
+                fail(path, "parameters", f"model {m} has no parameter '{name}'", ", ".join(sorted(iface.parameters)))
         for o in outputs[m]:
             if o not in iface.variables:
-                _fail(path, "study.outputs", f"model {m} has no variable '{o}'", ", ".join(iface.outputs))
+                fail(path, "study.outputs", f"model {m} has no variable '{o}'", ", ".join(iface.outputs))
         outputs[m] = outputs[m] or list(iface.outputs)
     return SweepConfig(path, st["models"], st["stop_time"], st["output_interval"], outputs, excitation, parameters,
                        sets, st["tolerance"], st["title"])

@@ -6,12 +6,12 @@ optional level, level_value, excitation, notes. Units are converted to SI on rea
 from __future__ import annotations
 
 import pathlib
-import tomllib
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .signals import assert_uniform
+from .tomlfile import read_toml
 
 TO_SI = {"m": 1.0, "mm": 1e-3, "rad": 1.0, "m/s": 1.0, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0, "g": 9.80665, "N": 1.0}
 
@@ -72,13 +72,9 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
     """Read one CSV + TOML pair (the sidecar has the same stem); validate and convert to SI."""
     csv_path = pathlib.Path(csv_path)
     side = csv_path.with_suffix(".toml")
-    for p in (csv_path, side):
-        if not p.is_file():
-            raise MeasurementError(f"{p}: file not found")
-    try:
-        meta = tomllib.loads(side.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise MeasurementError(f"{side}: not valid TOML: {exc}") from exc
+    if not csv_path.is_file():
+        raise MeasurementError(f"{csv_path}: file not found")
+    meta = read_toml(side, MeasurementError)
     allowed = {"model", "sample_rate_hz", "inputs", "outputs", "level", "level_value", "excitation", "notes"}
     extra = set(meta) - allowed
     if extra:

@@ -2,14 +2,14 @@
 from __future__ import annotations
 
 import pathlib
-import tomllib
 from dataclasses import dataclass, field
 
 from .build import EXAMPLES
-from .config import ConfigError, _fail, _numbers, _take
+from .config import ConfigError, check_numbers, check_table, fail
 from .excitation import Excitation
 from .objective import FreeParameter, ObjectiveChannel
 from .optim.nno import NNOSettings
+from .tomlfile import read_toml
 
 METHODS = ("nno", "nno+polish", "ga", "de", "polish")
 
@@ -42,103 +42,94 @@ class FitConfig:
     products: list[tuple[str, str]] = field(default_factory=list)
 
 
-def _read(path):
-    if not path.is_file():
-        raise ConfigError(f"{path}: file not found")
-    try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML: {exc}") from exc
-
-
 def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
     """Read and validate a fit study. fmu_parameters(model) -> set of settable names (to reject unknown ones)."""
     path = pathlib.Path(path)
-    doc = _read(path)
+    doc = read_toml(path, ConfigError)
     sections = {"fit", "target", "experiment", "objective", "variables", "nno", "polish", "ga", "report"}
     extra = set(doc) - sections
     if extra:
-        _fail(path, sorted(extra)[0], "unknown section", ", ".join(sorted(sections)))
+        fail(path, sorted(extra)[0], "unknown section", ", ".join(sorted(sections)))
     for s in ("fit", "target", "objective", "variables"):
         if s not in doc:
-            _fail(path, s, "missing section")
-    fit = _take(doc["fit"], path, "fit", {"model": (str, True, None), "method": (str, False, "nno"),
+            fail(path, s, "missing section")
+    fit = check_table(doc["fit"], path, "fit", {"model": (str, True, None), "method": (str, False, "nno"),
                                           "budget": (int, False, 60), "seed": (int, False, 0),
                                           "tolerance": (float, False, 1e-8)})
     if fit["model"] not in EXAMPLES:
-        _fail(path, "fit.model", f"unknown model '{fit['model']}'", ", ".join(EXAMPLES))
+        fail(path, "fit.model", f"unknown model '{fit['model']}'", ", ".join(EXAMPLES))
     if fit["method"] not in METHODS:
-        _fail(path, "fit.method", f"unknown method '{fit['method']}'", ", ".join(METHODS))
+        fail(path, "fit.method", f"unknown method '{fit['method']}'", ", ".join(METHODS))
     if fit["budget"] < 2:
-        _fail(path, "fit.budget", "needs at least 2 true evaluations")
-    tg = _take(doc["target"], path, "target", {"file": (str, True, None), "synthetic": (dict, False, None),
+        fail(path, "fit.budget", "needs at least 2 true evaluations")
+    tg = check_table(doc["target"], path, "target", {"file": (str, True, None), "synthetic": (dict, False, None),
                                                "use_inputs": (bool, False, False)})
     target_file = (path.parent / tg["file"]).resolve()
     synthetic = None
     if tg["synthetic"] is not None:
-        sy = _take(tg["synthetic"], path, "target.synthetic", {
+        sy = check_table(tg["synthetic"], path, "target.synthetic", {
             "excitation": (dict, True, None), "stop_time": (float, True, None), "sample_rate_hz": (float, True, None),
             "outputs": ("strings", True, None), "noise_std": (dict, False, {}), "parameters": (dict, False, {}),
             "oversample": (int, False, 10), "seed": (int, False, 1)})
         try:
             sy["excitation"] = Excitation(**sy["excitation"])
         except (TypeError, ValueError) as exc:
-            _fail(path, "target.synthetic.excitation", str(exc),
+            fail(path, "target.synthetic.excitation", str(exc),
                   "kind, amplitude, f_start, f_end, rate, octaves_per_minute, t_ramp")
-        sy["noise_std"] = _numbers(sy["noise_std"], path, "target.synthetic.noise_std")
-        sy["parameters"] = _numbers(sy["parameters"], path, "target.synthetic.parameters")
+        sy["noise_std"] = check_numbers(sy["noise_std"], path, "target.synthetic.noise_std")
+        sy["parameters"] = check_numbers(sy["parameters"], path, "target.synthetic.parameters")
         synthetic = sy
     elif not target_file.is_file():
-        _fail(path, "target.file", f"measurement {target_file} not found (and no [target.synthetic] to make it)")
-    fixed = _numbers(doc.get("experiment", {}), path, "experiment")
-    ob = _take(doc["objective"], path, "objective", {
+        fail(path, "target.file", f"measurement {target_file} not found (and no [target.synthetic] to make it)")
+    fixed = check_numbers(doc.get("experiment", {}), path, "experiment")
+    ob = check_table(doc["objective"], path, "objective", {
         "kind": (str, False, "psd_band"), "channels": (list, True, None), "segment_s": (float, False, 8.0),
         "warmup_s": (float, False, 0.0), "penalty": (float, False, 10.0)})
     if ob["kind"] not in ("psd_band", "psd_log", "time"):
-        _fail(path, "objective.kind", f"unknown kind '{ob['kind']}'", "psd_band, psd_log, time")
+        fail(path, "objective.kind", f"unknown kind '{ob['kind']}'", "psd_band, psd_log, time")
     channels = []
     for i, ch in enumerate(ob["channels"]):
-        c = _take(ch, path, f"objective.channels[{i}]", {"output": (str, True, None), "column": (str, True, None),
+        c = check_table(ch, path, f"objective.channels[{i}]", {"output": (str, True, None), "column": (str, True, None),
                                                           "bands": (list, False, []), "weight": (float, False, 1.0)})
         bands = []
         for b in c["bands"]:
             if not (isinstance(b, list) and len(b) == 2 and all(isinstance(v, (int, float)) for v in b) and b[0] < b[1]):
-                _fail(path, f"objective.channels[{i}].bands", f"{b!r} is not [low, high] in Hz with low < high")
+                fail(path, f"objective.channels[{i}].bands", f"{b!r} is not [low, high] in Hz with low < high")
             bands.append((float(b[0]), float(b[1])))
         if ob["kind"] != "time" and not bands:
-            _fail(path, f"objective.channels[{i}].bands", "a psd_band objective needs at least one band")
+            fail(path, f"objective.channels[{i}].bands", "a psd_band objective needs at least one band")
         channels.append(ObjectiveChannel(c["output"], c["column"], bands, c["weight"]))
     variables = []
     for name, b in doc["variables"].items():
         if not (isinstance(b, list) and len(b) == 2 and all(isinstance(v, (int, float)) for v in b)):
-            _fail(path, f"variables.{name}", f"{b!r} is not [lower, upper]")
+            fail(path, f"variables.{name}", f"{b!r} is not [lower, upper]")
         if not b[0] < b[1]:
-            _fail(path, f"variables.{name}", f"inverted or empty bounds {b}", "lower < upper")
+            fail(path, f"variables.{name}", f"inverted or empty bounds {b}", "lower < upper")
         variables.append(FreeParameter(name, float(b[0]), float(b[1])))
     if not variables:
-        _fail(path, "variables", "no parameter to fit")
+        fail(path, "variables", "no parameter to fit")
     if fmu_parameters is not None:
         known = fmu_parameters(fit["model"])
         for name in [v.name for v in variables] + list(fixed):
             if name not in known:
-                _fail(path, "variables" if name in doc["variables"] else "experiment",
+                fail(path, "variables" if name in doc["variables"] else "experiment",
                       f"model {fit['model']} has no parameter '{name}'", ", ".join(sorted(known)))
-    nn = _take(doc.get("nno", {}), path, "nno", {
+    nn = check_table(doc.get("nno", {}), path, "nno", {
         "init_sim": (int, False, 20), "hidden_sizes": (list, False, [15]), "p_size": (int, False, 20),
         "fun_tol": (float, False, 0.0), "x_tol": (float, False, 1e-3), "y_tol": (float, False, 1e-3),
         "ga_generations": (int, False, 50)})
-    pol = _take(doc.get("polish", {}), path, "polish", {"kind": (str, False, "time"), "budget": (int, False, 30)})
+    pol = check_table(doc.get("polish", {}), path, "polish", {"kind": (str, False, "time"), "budget": (int, False, 30)})
     if pol["kind"] not in ("psd_band", "psd_log", "time"):
-        _fail(path, "polish.kind", f"unknown kind '{pol['kind']}'", "psd_band, psd_log, time")
-    ga = _take(doc.get("ga", {}), path, "ga", {"pop_size": (int, False, 20)})
-    rep = _take(doc.get("report", {}), path, "report", {"truth": (dict, False, {}), "products": (list, False, [])})
+        fail(path, "polish.kind", f"unknown kind '{pol['kind']}'", "psd_band, psd_log, time")
+    ga = check_table(doc.get("ga", {}), path, "ga", {"pop_size": (int, False, 20)})
+    rep = check_table(doc.get("report", {}), path, "report", {"truth": (dict, False, {}), "products": (list, False, [])})
     nno_budget = fit["budget"] - (pol["budget"] if fit["method"] == "nno+polish" else 0)
     if nno_budget <= nn["init_sim"] and fit["method"] in ("nno", "nno+polish"):
-        _fail(path, "nno.init_sim", f"init_sim = {nn['init_sim']} leaves no NNO iteration within the budget "
+        fail(path, "nno.init_sim", f"init_sim = {nn['init_sim']} leaves no NNO iteration within the budget "
                                     f"({nno_budget} true evaluations for NNO)")
     settings = NNOSettings(nn["init_sim"], [int(h) for h in nn["hidden_sizes"]], nn["p_size"], nn["fun_tol"],
                            nno_budget, nn["x_tol"], nn["y_tol"], nn["ga_generations"], fit["seed"])
     return FitConfig(path, fit["model"], fit["method"], fit["budget"], fit["seed"], target_file, synthetic, fixed,
                      ob["kind"], channels, ob["segment_s"], ob["warmup_s"], ob["penalty"], fit["tolerance"],
                      tg["use_inputs"], variables, settings, pol["kind"], pol["budget"], ga["pop_size"],
-                     _numbers(rep["truth"], path, "report.truth"), [tuple(p) for p in rep["products"]])
+                     check_numbers(rep["truth"], path, "report.truth"), [tuple(p) for p in rep["products"]])
