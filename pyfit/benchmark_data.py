@@ -12,6 +12,8 @@ import numpy as np
 import scipy.interpolate
 import scipy.io
 
+from .signals import rms_db  # noqa: F401  (the benchmark's figure of merit, dB re 1 m)
+
 FS_HZ = 750.0  # sampling frequency of the official signals (not stored in the files)
 # ../shared/data/boucwen beside the repository, or the folder named by BOUCWEN_DATA_DIR
 DEFAULT_DIR = pathlib.Path(os.environ.get("BOUCWEN_DATA_DIR")
@@ -54,11 +56,6 @@ def upsample_spline(u: np.ndarray, factor: int) -> np.ndarray:
     t = np.arange(len(u))
     tf = np.arange((len(u) - 1) * factor + 1) / factor
     return scipy.interpolate.CubicSpline(t, u, bc_type="natural")(tf)
-
-
-def rms_db(err: np.ndarray) -> float:
-    """The benchmark's figure of merit: 20*log10(RMS(error)) in dB re 1 m."""
-    return float(20 * np.log10(np.sqrt(np.mean(np.asarray(err) ** 2))))
 
 
 def simulate_validation(runner, signal: ValidationSignal, upsample: int = 20, periods: int = 3,

@@ -11,7 +11,7 @@ from __future__ import annotations
 import ctypes
 import json
 import pathlib
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 
 import casadi as ca
 import numpy as np

@@ -2,7 +2,6 @@
 import os
 
 import numpy as np
-import pytest
 
 from pyfit.batch import RunSpec, run_batch, run_one
 from pyfit.fmu import FmuRunner

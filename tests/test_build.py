@@ -1,5 +1,4 @@
 """The build: every example becomes a valid FMI 2.0 FMU (ME + CS) whose two interfaces agree."""
-import pathlib
 import shutil
 import zipfile
 
