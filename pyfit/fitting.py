@@ -1,6 +1,7 @@
 """One fitting run: target measurement -> objective -> optimiser -> result.json and figures."""
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import pathlib
@@ -60,8 +61,7 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
     obj = _objective(cfg, fmu, measurement, cfg.objective_kind)
     n = len(cfg.variables)
     history, ann = [], []
-    settings = cfg.nno
-    settings.seed = seed
+    settings = dataclasses.replace(cfg.nno, seed=seed)
     if cfg.method in ("nno", "nno+polish"):
         res = nno(obj.residuals, n, settings)
         ann = [h for h in res.history if h.get("ann_error") is not None]
@@ -131,7 +131,7 @@ def _figures(cfg, obj: Objective, x, history, ann, out_dir):
     plots._save(fig, out_dir / "convergence.png")
     res = obj.simulate(x)
     fs = obj.fs
-    units = {c.output: "m" for c in cfg.channels}
+    units = {c.output: obj.runner.variables[c.output].unit for c in cfg.channels}
     for ch in cfg.channels:
         meas = obj.m.values[ch.column]
         curves = [("measured", meas, fs), ("fitted model", res[ch.output], fs)]
@@ -152,4 +152,4 @@ def _figures(cfg, obj: Objective, x, history, ann, out_dir):
             plots._save(fig, out_dir / f"psd_band_{ch.output}.png")
         plots.time_histories(out_dir / f"time_{ch.output}.png",
                              [("measured", obj.t, {ch.output: meas}), ("fitted model", res.time, {ch.output: res[ch.output]})],
-                             [ch.output], units, f"{cfg.path.stem}: displacement")
+                             [ch.output], units, f"{cfg.path.stem}: measured and fitted {ch.output}")
