@@ -9,10 +9,9 @@ import pathlib
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.interpolate
 import scipy.io
 
-from .signals import rms_db  # noqa: F401  (the benchmark's figure of merit, dB re 1 m)
+from .signals import rms_db, upsample_periodic, upsample_spline  # noqa: F401  (rms_db: the figure of merit)
 
 FS_HZ = 750.0  # sampling frequency of the official signals (not stored in the files)
 # ../shared/data/boucwen beside the repository, or the folder named by BOUCWEN_DATA_DIR
@@ -38,24 +37,6 @@ def load(name: str, folder: pathlib.Path = DEFAULT_DIR) -> ValidationSignal:
     u = scipy.io.loadmat(folder / f"uval_{name}.mat")[f"uval_{name}"].ravel().astype(float)
     y = scipy.io.loadmat(folder / f"yval_{name}.mat")[f"yval_{name}"].ravel().astype(float)
     return ValidationSignal(name, u, y, periodic=name == "multisine")
-
-
-def upsample_periodic(u: np.ndarray, factor: int) -> np.ndarray:
-    """Band-limited (FFT zero-padding) upsampling of one period of a periodic signal."""
-    n = len(u)
-    spec = np.fft.rfft(u)
-    padded = np.zeros(n * factor // 2 + 1, complex)
-    padded[:len(spec)] = spec
-    if n % 2 == 0:
-        padded[n // 2] *= 0.5  # split the Nyquist bin between +-fs/2
-    return np.fft.irfft(padded, n * factor) * factor
-
-
-def upsample_spline(u: np.ndarray, factor: int) -> np.ndarray:
-    """Cubic-spline upsampling of a non-periodic signal that starts from rest."""
-    t = np.arange(len(u))
-    tf = np.arange((len(u) - 1) * factor + 1) / factor
-    return scipy.interpolate.CubicSpline(t, u, bc_type="natural")(tf)
 
 
 def simulate_validation(runner, signal: ValidationSignal, upsample: int = 20, periods: int = 3,

@@ -128,7 +128,8 @@ def write_measurement(csv_path: str | pathlib.Path, model: str, t: np.ndarray, i
     dt = assert_uniform(t)
     cols = {**inputs, **outputs}
     data = np.column_stack([t] + [np.asarray(v[0]) / TO_SI[v[1]] for v in cols.values()])
-    np.savetxt(csv_path, data, delimiter=",", header=",".join(["t"] + list(cols)), comments="", fmt="%.10g")
+    np.savetxt(csv_path, data, delimiter=",", header=",".join(["t"] + list(cols)), comments="",
+               fmt=["%.15g"] + ["%.10g"] * len(cols))  # time with full precision: uniform to 1e-9 over long records
 
     def table(name, d):
         lines = [f"[{name}]"]

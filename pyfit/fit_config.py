@@ -9,6 +9,7 @@ from .config import ConfigError, check_numbers, check_table, fail
 from .excitation import Excitation
 from .objective import FreeParameter, ObjectiveChannel
 from .optim.nno import NNOSettings
+from .synthetic import MultisineInput
 from .tomlfile import read_toml
 
 METHODS = ("nno", "nno+polish", "ga", "de", "polish")
@@ -33,13 +34,27 @@ class FitConfig:
     penalty: float
     tolerance: float
     use_inputs: bool
+    input_upsample: int  # inputs are upsampled by this factor before they drive the FMU
+    input_periodic: bool  # upsample in the frequency domain (whole periods) instead of a cubic spline
     variables: list[FreeParameter]
     nno: NNOSettings
-    polish_kind: str
-    polish_budget: int
+    polish_kinds: list[str]  # polish stages, run in order (e.g. psd_log to get close, then time)
+    polish_budgets: list[int]
     ga_pop_size: int
     truth: dict[str, float] = field(default_factory=dict)
     products: list[tuple[str, str]] = field(default_factory=list)
+    benchmark: bool = False  # report the RMS error on the official Bouc-Wen validation signals
+
+    def problem_key(self) -> str:
+        """Identifies the optimisation problem (target, objective, free and fixed parameters), so that
+        methods are compared only on the same problem."""
+        import hashlib
+        import json
+
+        spec = [str(self.target_file.name), self.model, self.objective_kind, self.segment_s, self.warmup_s,
+                [(c.output, c.column, c.bands, c.weight) for c in self.channels],
+                [(v.name, v.lower, v.upper) for v in self.variables], sorted(self.fixed.items())]
+        return hashlib.sha256(json.dumps(spec).encode()).hexdigest()[:16]
 
 
 def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
@@ -63,19 +78,34 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
     if fit["budget"] < 2:
         fail(path, "fit.budget", "needs at least 2 true evaluations")
     tg = check_table(doc["target"], path, "target", {"file": (str, True, None), "synthetic": (dict, False, None),
-                                               "use_inputs": (bool, False, False)})
+                                               "use_inputs": (bool, False, False), "input_upsample": (int, False, 1),
+                                               "input_periodic": (bool, False, False)})
+    if tg["input_upsample"] < 1:
+        fail(path, "target.input_upsample", f"{tg['input_upsample']} is not a whole factor >= 1")
     target_file = (path.parent / tg["file"]).resolve()
     synthetic = None
     if tg["synthetic"] is not None:
         sy = check_table(tg["synthetic"], path, "target.synthetic", {
-            "excitation": (dict, True, None), "stop_time": (float, True, None), "sample_rate_hz": (float, True, None),
-            "outputs": ("strings", True, None), "noise_std": (dict, False, {}), "parameters": (dict, False, {}),
-            "oversample": (int, False, 10), "seed": (int, False, 1)})
+            "excitation": (dict, False, None), "multisine": (dict, False, None), "stop_time": (float, False, 0.0),
+            "sample_rate_hz": (float, True, None), "outputs": ("strings", True, None), "noise_std": (dict, False, {}),
+            "parameters": (dict, False, {}), "oversample": (int, False, 10), "seed": (int, False, 1),
+            "solver": (str, False, "cvodes"), "anti_alias": (bool, False, True)})
+        if (sy["excitation"] is None) == (sy["multisine"] is None):
+            fail(path, "target.synthetic", "needs exactly one of excitation and multisine")
+        if sy["solver"] not in ("cvodes", "newmark"):
+            fail(path, "target.synthetic.solver", f"unknown solver '{sy['solver']}'", "cvodes, newmark")
         try:
-            sy["excitation"] = Excitation(**sy["excitation"])
+            if sy["multisine"] is not None:
+                sy["excitation"] = MultisineInput(**sy.pop("multisine"))
+            else:
+                sy.pop("multisine")
+                sy["excitation"] = Excitation(**sy["excitation"])
         except (TypeError, ValueError) as exc:
             fail(path, "target.synthetic.excitation", str(exc),
-                  "kind, amplitude, f_start, f_end, rate, octaves_per_minute, t_ramp")
+                  "excitation: kind, amplitude, f_start, f_end, rate, octaves_per_minute, t_ramp; "
+                  "multisine: f_min, f_max, rms, samples_per_period, periods, seed")
+        if isinstance(sy["excitation"], Excitation) and sy["stop_time"] <= 0:
+            fail(path, "target.synthetic.stop_time", "a built-in excitation needs stop_time > 0 [s]")
         sy["noise_std"] = check_numbers(sy["noise_std"], path, "target.synthetic.noise_std")
         sy["parameters"] = check_numbers(sy["parameters"], path, "target.synthetic.parameters")
         synthetic = sy
@@ -118,12 +148,21 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
         "init_sim": (int, False, 20), "hidden_sizes": (list, False, [15]), "p_size": (int, False, 20),
         "fun_tol": (float, False, 0.0), "x_tol": (float, False, 1e-3), "y_tol": (float, False, 1e-3),
         "ga_generations": (int, False, 50)})
-    pol = check_table(doc.get("polish", {}), path, "polish", {"kind": (str, False, "time"), "budget": (int, False, 30)})
-    if pol["kind"] not in ("psd_band", "psd_log", "time"):
-        fail(path, "polish.kind", f"unknown kind '{pol['kind']}'", "psd_band, psd_log, time")
+    raw_polish = dict(doc.get("polish", {}))
+    if isinstance(raw_polish.get("budget"), int):
+        raw_polish["budget"] = [raw_polish["budget"]]
+    pol = check_table(raw_polish, path, "polish", {"kind": ("strings", False, ["time"]), "budget": (list, False, [30])})
+    for k in pol["kind"]:
+        if k not in ("psd_band", "psd_log", "time"):
+            fail(path, "polish.kind", f"unknown kind '{k}'", "psd_band, psd_log, time (or a list of them)")
+    if len(pol["budget"]) != len(pol["kind"]) or not all(isinstance(b, int) and b > 0 for b in pol["budget"]):
+        fail(path, "polish.budget", f"{pol['budget']!r} must be one positive whole number per polish.kind stage")
     ga = check_table(doc.get("ga", {}), path, "ga", {"pop_size": (int, False, 20)})
-    rep = check_table(doc.get("report", {}), path, "report", {"truth": (dict, False, {}), "products": (list, False, [])})
-    nno_budget = fit["budget"] - (pol["budget"] if fit["method"] == "nno+polish" else 0)
+    rep = check_table(doc.get("report", {}), path, "report", {"truth": (dict, False, {}), "products": (list, False, []),
+                                                            "benchmark": (bool, False, False)})
+    if rep["benchmark"] and fit["model"] != "SDOFBoucWen":
+        fail(path, "report.benchmark", "the Bouc-Wen benchmark validation needs model = \"SDOFBoucWen\"")
+    nno_budget = fit["budget"] - (sum(pol["budget"]) if fit["method"] == "nno+polish" else 0)
     if nno_budget <= nn["init_sim"] and fit["method"] in ("nno", "nno+polish"):
         fail(path, "nno.init_sim", f"init_sim = {nn['init_sim']} leaves no NNO iteration within the budget "
                                     f"({nno_budget} true evaluations for NNO)")
@@ -131,5 +170,6 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
                            nno_budget, nn["x_tol"], nn["y_tol"], nn["ga_generations"], fit["seed"])
     return FitConfig(path, fit["model"], fit["method"], fit["budget"], fit["seed"], target_file, synthetic, fixed,
                      ob["kind"], channels, ob["segment_s"], ob["warmup_s"], ob["penalty"], fit["tolerance"],
-                     tg["use_inputs"], variables, settings, pol["kind"], pol["budget"], ga["pop_size"],
-                     check_numbers(rep["truth"], path, "report.truth"), [tuple(p) for p in rep["products"]])
+                     tg["use_inputs"], tg["input_upsample"], tg["input_periodic"], variables, settings, pol["kind"], pol["budget"], ga["pop_size"],
+                     check_numbers(rep["truth"], path, "report.truth"), [tuple(p) for p in rep["products"]],
+                     rep["benchmark"])

@@ -10,7 +10,7 @@ from dataclasses import asdict
 
 import numpy as np
 
-from . import __version__, plots, signals
+from . import __version__, benchmark_data, plots, signals
 from .data import read_measurement
 from .fit_config import FitConfig
 from .objective import Objective
@@ -28,7 +28,8 @@ def ensure_target(cfg: FitConfig) -> pathlib.Path:
         raise FileNotFoundError(f"{cfg.path}: [target.file] {cfg.target_file} not found")
     s = cfg.synthetic
     spec = SyntheticSpec(cfg.model, s["excitation"], s["stop_time"], s["sample_rate_hz"], s["outputs"],
-                         s["parameters"], s["noise_std"], s["oversample"], s["seed"])
+                         s["parameters"], s["noise_std"], s["oversample"], s["seed"], solver=s["solver"],
+                         anti_alias=s["anti_alias"])
     tmp = cfg.target_file.with_name(cfg.target_file.stem + ".partial.csv")
     write_synthetic(tmp, spec)
     tmp.with_suffix(".toml").replace(cfg.target_file.with_suffix(".toml"))
@@ -49,11 +50,13 @@ def _versions() -> dict:
 
 def _objective(cfg: FitConfig, fmu, measurement, kind: str) -> Objective:
     return Objective(str(fmu), measurement, cfg.variables, cfg.channels, cfg.fixed, kind, cfg.segment_s,
-                     cfg.warmup_s, cfg.tolerance, cfg.penalty, cfg.use_inputs)
+                     cfg.warmup_s, cfg.tolerance, cfg.penalty, cfg.use_inputs, cfg.input_upsample, cfg.input_periodic)
 
 
-def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: int) -> dict:
-    """Fit with cfg's method and the given seed; write result.json and figures into out_dir; return the result."""
+def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: int,
+            stop_at: float | None = None) -> dict:
+    """Fit with cfg's method and the given seed; write result.json and figures into out_dir; return the result.
+    stop_at: the GA baseline stops when its error first reaches this value (the NNO-vs-GA comparison)."""
     out_dir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     fmu = ensure_fmu(cfg.model, fmu_dir)
@@ -66,21 +69,23 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
         res = nno(obj.residuals, n, settings)
         ann = [h for h in res.history if h.get("ann_error") is not None]
     elif cfg.method == "ga":
-        res, _ = baselines.ga_direct(obj.residuals, n, cfg.budget, cfg.ga_pop_size, seed)
+        res, _ = baselines.ga_direct(obj.residuals, n, cfg.budget, cfg.ga_pop_size, seed, stop_at)
     elif cfg.method == "de":
         res = baselines.differential_evolution(obj.residuals, n, cfg.budget, seed)
     else:
         res = baselines.polish(obj.residuals, np.full(n, 0.5), cfg.budget)
     history = [dict(h, stage="global") for h in res.history]
     best_x, n_eval, stop = res.x, res.n_evaluations, res.stop_reason
+    objectives = {cfg.objective_kind: obj}
+    final_obj = obj
     if cfg.method == "nno+polish":
-        pobj = obj if cfg.polish_kind == cfg.objective_kind else _objective(cfg, fmu, measurement, cfg.polish_kind)
-        pol = baselines.polish(pobj.residuals, best_x, cfg.polish_budget)
-        history += [dict(h, stage="polish", evaluations=h["evaluations"] + n_eval) for h in pol.history]
-        best_x, n_eval, stop = pol.x, n_eval + pol.n_evaluations, f"{stop}+polish:{pol.stop_reason}"
-        final_obj = pobj
-    else:
-        final_obj = obj
+        for kind, budget in zip(cfg.polish_kinds, cfg.polish_budgets):
+            if kind not in objectives:
+                objectives[kind] = _objective(cfg, fmu, measurement, kind)
+            final_obj = objectives[kind]
+            pol = baselines.polish(final_obj.residuals, best_x, budget)
+            history += [dict(h, stage=f"polish:{kind}", evaluations=h["evaluations"] + n_eval) for h in pol.history]
+            best_x, n_eval, stop = pol.x, n_eval + pol.n_evaluations, f"{stop}+{kind}:{pol.stop_reason}"
     error = float(np.sum(obj.residuals(best_x) ** 2))
     ident = baselines.identifiability(final_obj.residuals, best_x, cfg.variables)
     params = obj.params(best_x)
@@ -89,15 +94,42 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
         "config": str(cfg.path), "config_text": cfg.path.read_text(), "model": cfg.model, "method": cfg.method,
         "seed": seed, "parameters": fitted, "x_unit": [float(v) for v in best_x], "objective": error,
         "band_error_percent": obj.band_error_percent(best_x) if cfg.objective_kind != "time" else {},
+        "objective_kind": cfg.objective_kind, "problem": cfg.problem_key(), "stop_at": stop_at,
+        "global_best_so_far": np.minimum.accumulate([h["true_error"] for h in res.history]).tolist(),
         "true_evaluations": int(n_eval), "stop_reason": stop, "wall_s": time.perf_counter() - t0,
         "identifiability": asdict(ident), "recovery": recovery(fitted, cfg), "history": history,
         "versions": _versions(), "fmu_sha256": hashlib.sha256(pathlib.Path(fmu).read_bytes()).hexdigest(),
         "target": str(cfg.target_file),
     }
+    if cfg.benchmark:
+        result["benchmark_rms_db"] = benchmark_validation(obj, best_x, out_dir)
     (out_dir / "result.json").write_text(json.dumps(result, indent=1, default=float))
     _figures(cfg, obj, best_x, history, ann, out_dir)
-    obj.close()
+    for o in objectives.values():
+        o.close()
     return result
+
+
+def benchmark_validation(obj: Objective, x, out_dir: pathlib.Path) -> dict[str, float]:
+    """RMS error [dB re 1 m] of the fitted model on the official Bouc-Wen validation signals (never used to
+    estimate), with a figure of the error signals."""
+    import matplotlib.pyplot as plt
+
+    params = obj.params(x)
+    out = {}
+    fig, axes = plt.subplots(2, 1, figsize=(7, 5))
+    for ax, (name, upsample) in zip(axes, (("multisine", 20), ("sinesweep", 4))):
+        sig = benchmark_data.load(name)
+        y = benchmark_data.simulate_validation(obj.runner, sig, upsample=upsample, params=params)
+        out[name] = benchmark_data.rms_db(y - sig.y)
+        t = np.arange(len(y)) / benchmark_data.FS_HZ
+        ax.plot(t, 1e6 * (y - sig.y), lw=0.5)
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("y_model − y_official [µm]")
+        ax.set_title(f"{name}: RMS error {out[name]:.1f} dB re 1 m (official output RMS "
+                     f"{1e6 * np.sqrt(np.mean(sig.y ** 2)):.0f} µm)", fontsize=9)
+    plots._save(fig, out_dir / "benchmark_validation.png")
+    return out
 
 
 def recovery(fitted: dict, cfg: FitConfig) -> dict:

@@ -15,7 +15,7 @@ import numpy as np
 
 from . import signals
 from .data import Measurement
-from .fmu import FmuRunner
+from .fmu import FmuRunner, SimulationResult
 
 
 @dataclass
@@ -60,7 +60,7 @@ class Objective:
     def __init__(self, fmu: str, measurement: Measurement, variables: list[FreeParameter],
                  channels: list[ObjectiveChannel], fixed: dict | None = None, kind: str = "psd_band",
                  segment_s: float = 8.0, warmup_s: float = 0.0, tolerance: float = 1e-8, penalty: float = 10.0,
-                 use_inputs: bool = False):
+                 use_inputs: bool = False, input_upsample: int = 1, input_periodic: bool = False):
         if kind not in ("psd_band", "psd_log", "time"):
             raise ValueError(f"objective kind '{kind}' unknown; allowed: psd_band, psd_log, time")
         self.runner = FmuRunner(fmu)
@@ -73,6 +73,8 @@ class Objective:
         self.tolerance = tolerance
         self.penalty = penalty
         self.use_inputs = use_inputs
+        self.input_upsample = int(input_upsample)
+        self._inputs = self._fine_inputs(input_periodic) if use_inputs else None
         self.fs = measurement.sample_rate_hz
         self.t = measurement.t - measurement.t[0]
         self.first = int(round(warmup_s * self.fs))
@@ -103,14 +105,33 @@ class Objective:
         p.update({v.name: v.value(u) for v, u in zip(self.variables, np.clip(x, 0.0, 1.0))})
         return p
 
+    def _fine_inputs(self, periodic: bool) -> dict[str, np.ndarray]:
+        """Measured inputs on the FMU's drive grid: upsampled by input_upsample, band-limited (FFT) for
+        whole periods or by a cubic spline otherwise (linear interpolation of a 750 Hz multisine with
+        content up to 150 Hz would itself be a model error)."""
+        q = self.input_upsample
+        out = {}
+        for c, ch in self.m.inputs.items():
+            u = self.m.values[c]
+            if q == 1:
+                out[ch.model_variable] = u
+            elif periodic:
+                out[ch.model_variable] = signals.upsample_periodic(u, q)[:(len(u) - 1) * q + 1]
+            else:
+                out[ch.model_variable] = signals.upsample_spline(u, q)
+        return out
+
     def simulate(self, x, outputs=None):
         """The FMU's response on the measurement's time grid."""
-        inputs = None
-        if self.use_inputs:
-            inputs = {ch.model_variable: self.m.values[c] for c, ch in self.m.inputs.items()}
-        return self.runner.simulate(self.t[-1], 1.0 / self.fs, outputs or [c.output for c in self.channels],
-                                    self.params(x), inputs=inputs, input_time=self.t if inputs else None,
-                                    tolerance=self.tolerance)
+        q = self.input_upsample if self.use_inputs else 1
+        dt = 1.0 / (self.fs * q)
+        inputs = self._inputs
+        input_time = np.arange(len(next(iter(inputs.values())))) * dt if inputs else None
+        res = self.runner.simulate(self.t[-1], dt, outputs or [c.output for c in self.channels], self.params(x),
+                                   inputs=inputs, input_time=input_time, tolerance=self.tolerance)
+        if q > 1:
+            res = SimulationResult(res.time[::q], {k: v[::q] for k, v in res.values.items()}, res.ok, res.message)
+        return res
 
     def residuals(self, x) -> np.ndarray:
         """Residual vector (finite; the penalty vector when the simulation fails)."""

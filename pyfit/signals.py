@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.interpolate
 import scipy.signal
 
 
@@ -174,3 +175,21 @@ def band_psd_error(f: np.ndarray, psd: np.ndarray, psd_ref: np.ndarray, band: tu
     if not sel.any():
         raise ValueError(f"no PSD bin in band {band} Hz")
     return (psd[sel] - psd_ref[sel]) / psd_ref[sel]
+
+
+def upsample_periodic(u: np.ndarray, factor: int) -> np.ndarray:
+    """Band-limited (FFT zero-padding) upsampling of one period of a periodic signal."""
+    n = len(u)
+    spec = np.fft.rfft(u)
+    padded = np.zeros(n * factor // 2 + 1, complex)
+    padded[:len(spec)] = spec
+    if n % 2 == 0:
+        padded[n // 2] *= 0.5  # split the Nyquist bin between +-fs/2
+    return np.fft.irfft(padded, n * factor) * factor
+
+
+def upsample_spline(u: np.ndarray, factor: int) -> np.ndarray:
+    """Cubic-spline upsampling of a non-periodic signal that starts from rest."""
+    t = np.arange(len(u))
+    tf = np.arange((len(u) - 1) * factor + 1) / factor
+    return scipy.interpolate.CubicSpline(t, u, bc_type="natural")(tf)

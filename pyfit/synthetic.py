@@ -1,24 +1,47 @@
 """Synthetic 'measured' data without the inverse crime.
 
-The truth is simulated by the independent CasADi reference (CVODES, tight tolerance) at `oversample`
-times the sensor rate, passed through a sensor chain (zero-phase FIR anti-alias filter and decimation)
-and measurement noise, and written as a design-section-5 measurement. The model being fitted is the
-FMU (another implementation and another integrator), sampled directly at the sensor rate.
+The truth is simulated by the independent CasADi reference (CVODES at tight tolerance, or the seed's
+Newmark scheme) at `oversample` times the sensor rate, passed through a sensor chain (zero-phase FIR
+anti-alias filter and decimation, or plain sampling as the Bouc-Wen benchmark did) and measurement noise,
+and written as a design-section-5 measurement. The model being fitted is the FMU (another
+implementation and another integrator), sampled directly at the sensor rate.
+
+The excitation is a built-in one (sine, sweeps) or a measured force input: a random-phase multisine
+(periodic, band-limited; upsampled to the fine grid in the frequency domain).
 """
 from __future__ import annotations
 
+import dataclasses
 import pathlib
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.signal
 
+from . import signals
 from .data import write_measurement
-from .excitation import Excitation
+from .excitation import Excitation, multisine
 from .reference import integrate, models
 
 UNITS = {"y": "m", "y1": "m", "y2": "m", "x1": "m", "x2": "m", "xg1": "m", "xg2": "m", "F_clamp": "N",
          "z": "N", "v": "m/s", "v1": "m/s", "v2": "m/s", "phi1": "rad", "phi2": "rad"}
+
+
+@dataclass(frozen=True)
+class MultisineInput:
+    """A force input of whole periods of a random-phase multisine: band [Hz], RMS [N], samples per period."""
+
+    f_min: float
+    f_max: float
+    rms: float
+    samples_per_period: int
+    periods: int
+    seed: int = 0
+
+    def __call__(self, fs: float) -> np.ndarray:
+        """All periods at the sensor rate fs [Hz]."""
+        return np.tile(multisine(self.samples_per_period, fs, self.f_min, self.f_max, self.rms, self.seed),
+                       self.periods)
 
 
 @dataclass
@@ -26,8 +49,8 @@ class SyntheticSpec:
     """What to simulate and how the sensors see it (times in s, rates in Hz, noise in SI units)."""
 
     model: str
-    excitation: Excitation
-    stop_time: float
+    excitation: Excitation | MultisineInput
+    stop_time: float  # s (ignored for a multisine: periods x samples_per_period / sample_rate_hz)
     sample_rate_hz: float
     outputs: list[str]
     params: dict = field(default_factory=dict)
@@ -36,28 +59,48 @@ class SyntheticSpec:
     seed: int = 0
     level: str = ""
     level_value: float | None = None
+    solver: str = "cvodes"  # or "newmark"
+    anti_alias: bool = True  # zero-phase FIR before decimation; False = plain sampling
 
 
 def simulate_truth(spec: SyntheticSpec) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """Sensor-rate time, measured outputs (filtered, decimated, noisy) and exact excitation input signals."""
+    """Sensor-rate time, measured outputs (sensor chain + noise) and the exact input signals."""
+    if spec.solver not in ("cvodes", "newmark"):
+        raise ValueError(f"solver '{spec.solver}' unknown; allowed: cvodes, newmark")
     ref = models.by_name(spec.model)
-    fine_dt = 1.0 / (spec.sample_rate_hz * spec.oversample)
-    n_fine = int(round(spec.stop_time / fine_dt))
-    t_fine = np.arange(n_fine + 1) * fine_dt
-    truth = integrate.simulate_cvodes(ref, t_fine, params=spec.params, excitation=spec.excitation,
-                                      rtol=1e-10, atol=1e-14)
+    fs = spec.sample_rate_hz
+    fine_dt = 1.0 / (fs * spec.oversample)
+    sampled, excitation = None, spec.excitation
+    if isinstance(spec.excitation, MultisineInput):
+        u = spec.excitation(fs)
+        t = np.arange(len(u)) / fs
+        sampled = {ref.input_names[0]: signals.upsample_periodic(u, spec.oversample)}
+        t_fine = np.arange(len(u) * spec.oversample) * fine_dt
+        excitation = None
+    else:
+        n_fine = int(round(spec.stop_time / fine_dt))
+        t_fine = np.arange(n_fine + 1) * fine_dt
+        t = t_fine[::spec.oversample]
+    if spec.solver == "cvodes":
+        truth = integrate.simulate_cvodes(ref, t_fine, params=spec.params, excitation=excitation, inputs=sampled,
+                                          rtol=1e-10, atol=1e-14)
+    else:
+        truth = integrate.simulate_newmark(ref, t_fine, params=spec.params, excitation=excitation, inputs=sampled)
     rng = np.random.default_rng(spec.seed)
-    t = t_fine[::spec.oversample]
     measured = {}
     for name in spec.outputs:
-        y = scipy.signal.decimate(truth[name], spec.oversample, ftype="fir", zero_phase=True)[:len(t)]
+        if spec.anti_alias:
+            y = scipy.signal.decimate(truth[name], spec.oversample, ftype="fir", zero_phase=True)[:len(t)]
+        else:
+            y = truth[name][::spec.oversample][:len(t)]
         measured[name] = y + rng.normal(0.0, spec.noise_std.get(name, 0.0), len(y))
-    e = spec.excitation(t)
     inputs = {}
-    if ref.input_names == ["u"] or ref.input_names == ["f"]:
-        inputs[ref.input_names[0]] = e
+    if sampled is not None:
+        inputs[ref.input_names[0]] = sampled[ref.input_names[0]][::spec.oversample]
+    elif ref.input_names == ["u"] or ref.input_names == ["f"]:
+        inputs[ref.input_names[0]] = spec.excitation(t)
     elif spec.excitation.kind:
-        inputs["x_base"] = e
+        inputs["x_base"] = spec.excitation(t)
     return t, measured, inputs
 
 
@@ -66,9 +109,10 @@ def write_synthetic(path: str | pathlib.Path, spec: SyntheticSpec) -> pathlib.Pa
     t, measured, inputs = simulate_truth(spec)
     in_cols = {f"{k}_meas": (v, UNITS.get(k, "N" if k in ("u", "f") else "m"), k) for k, v in inputs.items()}
     out_cols = {f"{k}_meas": (v, UNITS.get(k, "m"), k) for k, v in measured.items()}
-    exc = spec.excitation
-    excitation = {"kind": exc.kind, "amplitude": exc.amplitude, "f_start": exc.f_start, "f_end": exc.f_end,
-                  "rate": exc.rate, "octaves_per_minute": exc.octaves_per_minute, "t_ramp": exc.t_ramp}
-    notes = (f"synthetic: CasADi reference (CVODES) at {spec.oversample}x the sensor rate, zero-phase FIR "
-             f"anti-alias + decimation, noise std {spec.noise_std}, seed {spec.seed}")
+    excitation = dataclasses.asdict(spec.excitation)
+    if isinstance(spec.excitation, MultisineInput):
+        excitation = dict(excitation, kind="multisine")
+    chain = "zero-phase FIR anti-alias + decimation" if spec.anti_alias else "plain sampling"
+    notes = (f"synthetic: CasADi reference ({spec.solver}) at {spec.oversample}x the sensor rate, {chain}, "
+             f"noise std {spec.noise_std}, seed {spec.seed}")
     return write_measurement(path, spec.model, t, in_cols, out_cols, spec.level, spec.level_value, excitation, notes)

@@ -11,18 +11,18 @@ import sys
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from pyfit import crosscheck  # noqa: E402
-from pyfit.build import EXAMPLES  # noqa: E402
+from pyfit.reference.models import NAMES  # noqa: E402
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("names", nargs="*", help="FMUs to check (default: all examples)")
+    ap.add_argument("names", nargs="*", help="FMUs to check (default: every example with a reference model)")
     ap.add_argument("--fmus", default="fmus", help="folder with the FMUs")
     ap.add_argument("--out", default="results/crosscheck", help="output folder")
     ap.add_argument("--samples", type=int, default=10, help="sampled states for the RHS and Jacobian levels")
     args = ap.parse_args()
     try:
-        results = crosscheck.run(pathlib.Path(args.fmus), pathlib.Path(args.out), args.names or list(EXAMPLES),
+        results = crosscheck.run(pathlib.Path(args.fmus), pathlib.Path(args.out), args.names or list(NAMES),
                                  args.samples)
     except (FileNotFoundError, KeyError) as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -18,7 +18,9 @@ RUNS = {
     "TwoDOFc": (["y1", "y2", "z"], {"exc_rate": 6.0}, 6.0),
     "TwoDOFd": (["y1", "y2", "z"], {"exc_rate": 6.0}, 6.0),
     "StockbridgeDamper": (["x1", "x2", "F_clamp"], {"exc_rate": 10.0}, 3.5),
-}
+    "MassSpringDamper": (["y", "a"], {"exc_rate": 6.0}, 4.0),
+    "DamperElement": (["x1", "F_clamp"], {"exc_type": 4, "exc_rate": 10.0}, 1.5),
+}  # the elements driven only by inputs are checked in test_elements.py
 
 
 @pytest.mark.parametrize("name", list(EXAMPLES))
@@ -43,7 +45,7 @@ def test_fmu_is_valid_fmi2_with_me_and_cs(fmu_dir, name):
         assert {"m", "c", "k", "alpha", "beta", "gamma", "delta", "nu", "u", "y", "v", "z"} <= names
 
 
-@pytest.mark.parametrize("name", list(EXAMPLES))
+@pytest.mark.parametrize("name", list(RUNS))
 def test_model_exchange_and_co_simulation_agree(runner, name):
     outputs, params, stop = RUNS[name]
     cs = runner(name).simulate(stop, 1e-3, outputs, params, tolerance=1e-11)

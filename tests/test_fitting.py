@@ -1,5 +1,6 @@
 """Fitting machinery: identifiability, surrogate, NNO, baselines, measurement files, fit configs, resume."""
 import json
+import pathlib
 import shutil
 import textwrap
 
@@ -8,7 +9,7 @@ import pytest
 
 from pyfit.config import ConfigError
 from pyfit.data import MeasurementError, read_measurement, write_measurement
-from pyfit.fit_batch import fit_batch
+from pyfit.fit_batch import evaluations_to_reach, fit_batch
 from pyfit.fit_config import load_fit
 from pyfit.objective import FreeParameter
 from pyfit.optim import baselines
@@ -189,3 +190,28 @@ def test_missing_target_file_is_named(tmp_path):
     cfg.write_text(textwrap.dedent(text))
     with pytest.raises(ConfigError, match=r"\[target.file\] measurement .*tiny.csv not found"):
         load_fit(cfg)
+
+
+def test_ga_baseline_runs_after_nno_and_stops_at_its_median(tmp_path, fmu_dir):
+    """The NNO-vs-GA comparison: the GA config (same problem) runs in a second phase, stops once it reaches the
+    NNO median final objective, and summary.md counts its evaluations; another problem is not compared."""
+    (tmp_path / "tiny.toml").write_text(TINY)
+    (tmp_path / "tiny_ga.toml").write_text(TINY.replace('method = "nno"', 'method = "ga"')
+                                           .replace("budget = 8", "budget = 40"))
+    (tmp_path / "other_ga.toml").write_text(TINY.replace('method = "nno"', 'method = "ga"')
+                                            .replace("alpha = [40000.0, 60000.0]", "alpha = [40000.0, 61000.0]"))
+    out = tmp_path / "out"
+    results = fit_batch([tmp_path / "tiny_ga.toml", tmp_path / "other_ga.toml", tmp_path / "tiny.toml"], repeats=1,
+                        out=out, fmu_dir=fmu_dir, workers=1, progress=False)
+    nno_runs = [r for r in results if r["method"] == "nno"]
+    ga_runs = [r for r in results if pathlib.Path(r["config"]).stem == "tiny_ga"]
+    other = [r for r in results if pathlib.Path(r["config"]).stem == "other_ga"]
+    goal = float(np.median([r["objective"] for r in nno_runs]))
+    assert all(r["stop_at"] == pytest.approx(goal) for r in ga_runs)
+    assert all(r["stop_at"] is None and r["true_evaluations"] == 8 for r in other)  # no NNO on that problem
+    for r in ga_runs:
+        reached = r["global_best_so_far"][-1] <= goal
+        assert reached == (r["stop_reason"] == "target")
+        assert r["true_evaluations"] == (evaluations_to_reach(r["global_best_so_far"], goal, 60) if reached else 40)
+    summary = (out / "summary.md").read_text()
+    assert "NNO vs GA (tiny vs tiny_ga, same problem)" in summary and "other_ga vs" not in summary

@@ -3,12 +3,11 @@ import numpy as np
 import pytest
 
 from pyfit import crosscheck
-from pyfit.build import EXAMPLES
 from pyfit.excitation import Excitation
 from pyfit.reference import integrate, models
 
 
-@pytest.mark.parametrize("name", list(EXAMPLES))
+@pytest.mark.parametrize("name", models.NAMES)
 def test_rhs_and_jacobian_agree_with_reference(fmu_dir, name):
     for r in crosscheck.check_rhs_and_jacobian(name, fmu_dir / f"{name}.fmu", n_samples=5):
         assert r.passed, (r.level, r.figures)
@@ -16,7 +15,7 @@ def test_rhs_and_jacobian_agree_with_reference(fmu_dir, name):
         assert r.figures["max_rel_error"] <= limit
 
 
-@pytest.mark.parametrize("name", list(EXAMPLES))
+@pytest.mark.parametrize("name", models.NAMES)
 def test_trajectories_agree_with_reference(fmu_dir, name):
     results = crosscheck.check_trajectories(name, fmu_dir / f"{name}.fmu")
     assert {r.level for r in results} == {"trajectory_sweep_ModelExchange", "trajectory_sweep_CoSimulation",

@@ -23,6 +23,12 @@ EXAMPLES = {
     "TwoDOFc": "StockbridgeDamper.Examples.TwoDOFc",
     "TwoDOFd": "StockbridgeDamper.Examples.TwoDOFd",
     "StockbridgeDamper": "StockbridgeDamper.Examples.StockbridgeDamper",
+    # element FMUs for exchange and co-simulation (causal interfaces)
+    "BoucWenElement": "StockbridgeDamper.Elements.BoucWenElement",
+    "BoucWenNormalizedElement": "StockbridgeDamper.Elements.BoucWenNormalizedElement",
+    "CubicSpringElement": "StockbridgeDamper.Elements.CubicSpringElement",
+    "MassSpringDamper": "StockbridgeDamper.Elements.MassSpringDamper",
+    "DamperElement": "StockbridgeDamper.Elements.DamperElement",
 }
 
 

@@ -165,6 +165,10 @@ def damper() -> ReferenceModel:
                           dict(DAMPER_DEFAULTS))
 
 
+# the examples with a hand-written reference; the element FMUs are checked against scipy in tests/test_elements.py
+NAMES = ("SDOFBoucWen", "TwoDOFa", "TwoDOFb", "TwoDOFc", "TwoDOFd", "StockbridgeDamper")
+
+
 def by_name(name: str) -> ReferenceModel:
     """The reference model of an exported example (SDOFBoucWen, TwoDOFa..d, StockbridgeDamper)."""
     if name == "SDOFBoucWen":

@@ -1,0 +1,84 @@
+"""Per-FMU documentation in the style of the Modelica Reference-FMUs: a README (what it is, variables with
+units) and a reference result CSV from a defined run, for users of other FMI tools."""
+from __future__ import annotations
+
+import pathlib
+
+import casadi as ca
+import numpy as np
+
+from .excitation import Excitation
+from .fmu import FmuRunner
+
+STEP = 1e-3  # s, output interval of the reference runs and spacing of their (linear) input samples
+STOP = 0.5  # s
+
+
+def _motion(exc: Excitation, t: np.ndarray, names: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """A prescribed motion and its exact first and second derivatives on the grid t."""
+    ts = ca.SX.sym("t")
+    x = exc(ts)
+    dx = ca.jacobian(x, ts)
+    f = ca.Function("motion", [ts], [x, dx, ca.jacobian(dx, ts)])
+    cols = [np.array(c).ravel() for c in f.map(len(t))(t[None, :])]
+    return dict(zip(names, cols))
+
+
+SINE_2MM = Excitation(kind=1, amplitude=2e-3, f_start=10.0)  # m, Hz
+CLAMP_SINE = Excitation(kind=1, amplitude=5e-4, f_start=12.0, t_ramp=0.1)
+
+# element -> (what the reference run does, input builder(t) or None, parameters, recorded outputs)
+REFERENCE_RUNS = {
+    "BoucWenElement": ("relative motion s = 2 mm sin(2π·10 Hz·t), default parameters",
+                       lambda t: _motion(SINE_2MM, t, ("s", "v")), {}, ["f", "df", "z"]),
+    "BoucWenNormalizedElement": ("relative motion s = 2 mm sin(2π·10 Hz·t), default parameters",
+                                 lambda t: _motion(SINE_2MM, t, ("s", "v")), {}, ["f", "df", "z"]),
+    "CubicSpringElement": ("relative motion s = 2 mm sin(2π·10 Hz·t), k3 = 1e6 N/m³",
+                           lambda t: _motion(SINE_2MM, t, ("s", "v")), {}, ["f"]),
+    "MassSpringDamper": ("built-in linear force sweep 120 N, 0 → 60 Hz at 0.5 Hz/s, input f = 0", None, {},
+                         ["y", "v", "a"]),
+    "DamperElement": ("clamp motion 0.5 mm sin(2π·12 Hz·t) with a 0.1 s ramp-in, default damper",
+                      lambda t: _motion(CLAMP_SINE, t, ("x_base", "v_base", "a_base")), {}, ["F_clamp", "x1", "x2"]),
+}
+
+
+def _table(md, causality: str) -> list[str]:
+    rows = [v for v in md.modelVariables if v.causality == causality]
+    if not rows:
+        return []
+    lines = [f"### {causality}s", "", "| name | unit | start | description |", "|---|---|---|---|"]
+    for v in rows:
+        lines.append(f"| `{v.name}` | {v.unit or v.declaredType and v.declaredType.unit or '1'} | "
+                     f"{v.start if v.start is not None else ''} | {(v.description or '').replace('|', chr(92) + '|')} |")
+    return lines + [""]
+
+
+def write_docs(name: str, fmu: str | pathlib.Path, out_dir: str | pathlib.Path) -> pathlib.Path:
+    """Write out_dir/<name>/README.md and <name>_ref.csv (the reference run of REFERENCE_RUNS[name])."""
+    what, make_inputs, params, outputs = REFERENCE_RUNS[name]
+    folder = pathlib.Path(out_dir) / name
+    folder.mkdir(parents=True, exist_ok=True)
+    runner = FmuRunner(str(fmu))
+    md = runner.model_description
+    t = np.arange(int(round(STOP / STEP)) + 1) * STEP
+    inputs = make_inputs(t) if make_inputs else None
+    res = runner.simulate(STOP, STEP, outputs, params, inputs=inputs, input_time=t if inputs else None,
+                          tolerance=1e-10)
+    if not res.ok:
+        raise RuntimeError(f"{name}: reference run failed: {res.message}")
+    cols = {"time": t, **(inputs or {}), **{o: res[o] for o in outputs}}
+    csv = folder / f"{name}_ref.csv"
+    np.savetxt(csv, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols), comments="",
+               fmt="%.12g")
+    runner.close()
+    lines = [f"# {name}", "", md.description or "", "",
+             f"FMI {md.fmiVersion} Model Exchange and Co-Simulation, generated from "
+             f"`modelica/` by `python scripts/build_fmus.py` (pyfit); GUID `{md.guid}`.",
+             "Co-simulation: adaptive DOPRI5 inside each communication step (tolerance from fmi2SetupExperiment), "
+             "inputs linear over a step when their derivatives are set (canInterpolateInputs).", ""]
+    lines += ["## Variables (SI units)", ""] + _table(md, "input") + _table(md, "output") + _table(md, "parameter")
+    lines += ["## Reference result", "", f"[`{csv.name}`]({csv.name}): {what}; output interval {STEP} s, "
+              f"{STOP} s, tolerance 1e-10, inputs linear between samples. Regenerate with "
+              "`python scripts/element_docs.py`.", ""]
+    (folder / "README.md").write_text("\n".join(lines))
+    return folder
