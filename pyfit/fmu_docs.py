@@ -39,6 +39,8 @@ REFERENCE_RUNS = {
                          ["y", "v", "a"]),
     "DamperElement": ("clamp motion 0.5 mm sin(2π·12 Hz·t) with a 0.1 s ramp-in, default damper",
                       lambda t: _motion(CLAMP_SINE, t, ("x_base", "v_base", "a_base")), {}, ["F_clamp", "x1", "x2"]),
+    "ConductorSpan": ("built-in shaker sine 5 N at 10 Hz at x_e = 14.1 m, input F_clamp = 0", None, {},
+                      ["y_d", "v_d", "a_d", "y_e", "E"]),
 }
 
 

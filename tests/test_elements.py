@@ -87,22 +87,27 @@ FMI_SIM = shutil.which("fmi-sim")
 
 
 @pytest.mark.skipif(FMI_SIM is None, reason="fmi-sim not installed: cargo install fmi-sim@0.7.0 --locked")
-@pytest.mark.parametrize("name", ["BoucWenElement", "BoucWenNormalizedElement", "CubicSpringElement"])
+@pytest.mark.parametrize("name", list(REFERENCE_RUNS))
 def test_element_fmus_run_in_the_second_importer(fmu_dir, runner, tmp_path, name):
-    t, u = sine_inputs()
-    inp = tmp_path / "in.csv"
-    np.savetxt(inp, np.column_stack([t, u["s"], u["v"]]), delimiter=",", header="time,s,v", comments="",
-               fmt="%.17g")
-    out = tmp_path / "out.csv"
-    proc = subprocess.run([FMI_SIM, "--model", str(fmu_dir / f"{name}.fmu"), "-i", str(inp), "-o", str(out),
-                           "co-simulation", "--output-interval", repr(DT), "-n", "0", "-s", "0", "-f", repr(STOP)],
-                          capture_output=True, text=True, timeout=300)
+    """Every element FMU runs in fmi-sim (co-simulation, inputs from a CSV) and agrees with pyfit's run."""
+    _, make_inputs, params, outputs = REFERENCE_RUNS[name]
+    t = np.arange(int(round(STOP / DT)) + 1) * DT
+    u = make_inputs(t) if make_inputs else {}
+    cmd = [FMI_SIM, "--model", str(fmu_dir / f"{name}.fmu"), "-o", str(tmp_path / "out.csv")]
+    if u:
+        np.savetxt(tmp_path / "in.csv", np.column_stack([t, *u.values()]), delimiter=",",
+                   header=",".join(["time", *u]), comments="", fmt="%.17g")
+        cmd += ["-i", str(tmp_path / "in.csv")]
+    cmd += ["co-simulation", "--output-interval", repr(DT), "-n", "0", "-s", "0", "-f", repr(STOP)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
-    other = np.genfromtxt(out, delimiter=",", names=True)
-    ours = runner(name).simulate(STOP, DT, ["f"], {}, inputs=u, input_time=t)
-    n = min(len(other), len(ours["f"]))
-    # fmi-sim holds the inputs over each 1e-4 s step (no input derivatives): differences O(w dt) = 6e-3
-    assert np.max(np.abs(other["f"][:n] - ours["f"][:n])) <= 2e-2 * np.max(np.abs(ours["f"]))
+    other = np.genfromtxt(tmp_path / "out.csv", delimiter=",", names=True)
+    ours = runner(name).simulate(STOP, DT, outputs[:1], params, inputs=u or None, input_time=t if u else None)
+    n = min(len(other), len(t))
+    o = outputs[0]
+    # fmi-sim holds the inputs over each 1e-4 s step (no input derivatives): differences O(w dt) ~ 1e-2 (2.5 %
+    # for the damper's F_clamp, which feeds the held clamp acceleration straight through)
+    assert np.max(np.abs(other[o][:n] - ours[o][:n])) <= 3e-2 * np.max(np.abs(ours[o]))
 
 
 @pytest.mark.parametrize("name", list(REFERENCE_RUNS))

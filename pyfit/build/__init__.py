@@ -29,6 +29,7 @@ EXAMPLES = {
     "CubicSpringElement": "StockbridgeDamper.Elements.CubicSpringElement",
     "MassSpringDamper": "StockbridgeDamper.Elements.MassSpringDamper",
     "DamperElement": "StockbridgeDamper.Elements.DamperElement",
+    "ConductorSpan": "StockbridgeDamper.Elements.ConductorSpan",
 }
 
 

@@ -113,7 +113,7 @@ def load(library: pathlib.Path, model_name: str) -> FlatModel:
     annotation = _annotation_to_dict(original.annotation)
     try:
         flat = mo_tree.flatten(copy.deepcopy(tree), model_name)
-        model = generate_model(tree, model_name, {"check_balanced": False})
+        model = generate_model(tree, model_name, {"check_balanced": False, "expand_vectors": True})
     except Exception as exc:
         raise ModelicaError(f"{model_name}: pymoca could not flatten the model: {exc}") from exc
     flat_class = list(flat.classes.values())[0]

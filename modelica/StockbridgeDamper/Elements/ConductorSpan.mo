@@ -1,0 +1,73 @@
+within StockbridgeDamper.Elements;
+model ConductorSpan "Laboratory conductor span: taut string between rigid ends, modal model (sine modes, every mode below 60 Hz for the default Drake ACSR span), a built-in shaker force at x_e and a damper clamp at x_d: clamp force in; clamp motion out"
+  constant Integer N = 27 "Number of modes kept (27 x 2.18 Hz = 59 Hz for the default span)";
+  parameter Real L(unit="m", min=0) = 30 "Span length";
+  parameter Real T(unit="N", min=0) = 28000 "Conductor tension (about 20 % of the rated tensile strength of ACSR Drake, 140 kN)";
+  parameter Real m_l(unit="kg/m", min=0) = 1.628 "Conductor mass per unit length (ACSR Drake)";
+  parameter Real zeta(unit="1", min=0) = 0.002 "Modal damping ratio of every mode (conductor self-damping, linearised)";
+  parameter Real x_d(unit="m", min=0) = 1.0 "Damper clamp position from the span end";
+  parameter Real m_c(unit="kg", min=0) = 0.6 "Damper clamp mass, carried by the span at x_d (set the damper FMU's m_c to 0)";
+  parameter Real x_e(unit="m", min=0) = 14.1 "Shaker force position from the span end";
+  parameter Integer exc_type(min=0, max=3) = 1 "Built-in shaker force: 0 off, 1 sine, 2 linear sweep, 3 log sweep";
+  parameter Real exc_amplitude(unit="N") = 5 "Shaker force amplitude";
+  parameter Real exc_f_start(unit="Hz", min=0) = 10 "Sine frequency or sweep start frequency";
+  parameter Real exc_f_end(unit="Hz", min=0) = 50 "Sweep end frequency";
+  parameter Real exc_rate(unit="Hz/s", min=0) = 0.5 "Linear sweep rate";
+  parameter Real exc_octaves_per_minute(unit="1/min") = 1 "Logarithmic sweep rate";
+  parameter Real exc_t_ramp(unit="s", min=0) = 0 "Smooth amplitude ramp-in time";
+  input Real F_clamp(unit="N", start=0) "Force the span applies to the damper clamp, upward (the damper FMU's F_clamp); the span feels -F_clamp";
+  output Real y_d(unit="m") "Span displacement at the damper clamp";
+  output Real v_d(unit="m/s") "Span velocity at the damper clamp";
+  output Real a_d(unit="m/s2") "Span acceleration at the damper clamp";
+  output Real y_e(unit="m") "Span displacement at the shaker";
+  output Real E(unit="J") "Mechanical energy of the span (modal kinetic + potential) and the clamp's kinetic energy";
+  output Real W_self(unit="J") "Energy dissipated by the span's self-damping since t = 0";
+  output Real W_shaker(unit="J") "Work done by the shaker force since t = 0";
+  Real q[N](each unit="m", each start=0) "Modal displacements (antinode amplitudes)";
+  Real qd[N](each unit="m/s", each start=0) "Modal velocities";
+  Real phi_d[N](each unit="1") "Mode shapes at the clamp";
+  Real phi_e[N](each unit="1") "Mode shapes at the shaker";
+  Real w[N](each unit="rad/s") "Natural circular frequencies";
+  Real P_n[N](each unit="W") "Self-damping power per mode";
+  Real E_n[N](each unit="J") "Energy per mode";
+  Real acc0[N](each unit="m/s2") "Modal accelerations without the clamp's inertia";
+  Real pa[N](each unit="m/s2") "phi_d*acc0";
+  Real p2[N](each unit="1") "phi_d^2";
+  Real F_e(unit="N") "Shaker force";
+  Real M(unit="kg") "Modal mass m_l*L/2";
+  Real yd_n[N](each unit="m") "Modal contributions to y_d";
+  Real vd_n[N](each unit="m/s") "Modal contributions to v_d";
+  Real ye_n[N](each unit="m") "Modal contributions to y_e";
+  Real ve_n[N](each unit="m/s") "Modal contributions to the velocity at the shaker";
+  Sources.Excitation excitation(kind=exc_type, amplitude=exc_amplitude, f_start=exc_f_start, f_end=exc_f_end,
+    rate=exc_rate, octaves_per_minute=exc_octaves_per_minute, t_ramp=exc_t_ramp) "Built-in shaker force signal";
+equation
+  M = m_l*L/2;
+  F_e = excitation.y;
+  for i in 1:N loop
+    w[i] = i*3.14159265358979*sqrt(T/m_l)/L;
+    phi_d[i] = sin(i*3.14159265358979*x_d/L);
+    phi_e[i] = sin(i*3.14159265358979*x_e/L);
+    // M*qdd + 2*zeta*w*M*qd + w^2*M*q = F_e*phi_e - (F_clamp + m_c*a_d)*phi_d, with a_d = sum(phi_d*qdd):
+    // the clamp mass couples the modes; solved in closed form (Sherman-Morrison) so that no algebraic loop remains
+    acc0[i] = (F_e*phi_e[i] - F_clamp*phi_d[i] - 2*zeta*w[i]*M*qd[i] - w[i]^2*M*q[i])/M;
+    pa[i] = phi_d[i]*acc0[i];
+    p2[i] = phi_d[i]^2;
+    der(q[i]) = qd[i];
+    der(qd[i]) = acc0[i] - m_c*a_d*phi_d[i]/M;
+    P_n[i] = 2*zeta*w[i]*M*qd[i]^2;
+    E_n[i] = 0.5*M*(qd[i]^2 + w[i]^2*q[i]^2);
+    yd_n[i] = phi_d[i]*q[i];
+    vd_n[i] = phi_d[i]*qd[i];
+    ye_n[i] = phi_e[i]*q[i];
+    ve_n[i] = phi_e[i]*qd[i];
+  end for;
+  y_d = sum(yd_n);
+  v_d = sum(vd_n);
+  a_d = sum(pa)/(1 + m_c*sum(p2)/M);
+  y_e = sum(ye_n);
+  E = sum(E_n) + 0.5*m_c*v_d^2;
+  der(W_self) = sum(P_n);
+  der(W_shaker) = F_e*sum(ve_n);
+  annotation(experiment(StartTime=0, StopTime=10, Interval=1e-3, Tolerance=1e-8));
+end ConductorSpan;
