@@ -2,7 +2,7 @@
 per mode in the aeolian band, the damping with the damper and the resonant amplitude reduction, for several
 damper positions.
 
-    python scripts/span.py [--positions 0.5 1.0 1.5 2.0] [--amplitude 0.005] [--out docs/figures/span]
+    python scripts/span.py [--positions 0.5 1.0 1.5 2.0] [--amplitude 0.005] [--out docs/figures/span] [--ssp FILE]
 """
 import argparse
 import pathlib
@@ -12,7 +12,8 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from pyfit.fmu import FmuRunner  # noqa: E402
 from pyfit.run_example import ensure_fmu  # noqa: E402
-from pyfit.span import reduction_table, write_report  # noqa: E402
+from pyfit.span import CONNECTIONS, reduction_table, write_report  # noqa: E402
+from pyfit.ssp import write_ssp  # noqa: E402
 
 
 def main() -> int:
@@ -22,6 +23,7 @@ def main() -> int:
     ap.add_argument("--amplitude", type=float, default=5e-3, help="antinode amplitude at the start [m]")
     ap.add_argument("--fmus", default="fmus")
     ap.add_argument("--out", default="docs/figures/span")
+    ap.add_argument("--ssp", help="also write the coupled system as an SSP 1.0 archive (.ssp) for other tools")
     args = ap.parse_args()
     fmus = pathlib.Path(args.fmus)
     span, damper = (FmuRunner(str(ensure_fmu(n, fmus))) for n in ("ConductorSpan", "DamperElement"))
@@ -29,6 +31,10 @@ def main() -> int:
                            amplitude=args.amplitude)
     write_report(rows, args.out)
     print((pathlib.Path(args.out) / "reduction.md").read_text())
+    if args.ssp:
+        write_ssp(args.ssp, "SpanWithDamper", {"span": span.path, "damper": damper.path}, CONNECTIONS,
+                  {"span": {"exc_type": 1, "x_d": args.positions[0]}, "damper": {"m_c": 0.0}}, stop_time=10.0)
+        print(f"wrote {args.ssp}")
     return 0
 
 
