@@ -119,9 +119,8 @@ def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], 
         fmu.enterInitializationMode()
         ports[name] = _Port(r)
     # every output any connection or the record reads, per FMU, read in one call
-    reads = {name: sorted({v for (f, v), _, _ in conns if f == name} | {v for _, _, d in conns if d and d[0] == name
-                                                                        for v in [d[1]]}
-                          | {v for f, v in rec if f == name}) for name in runners}
+    needed = [src for src, _, _ in conns] + [d for _, _, d in conns if d] + rec
+    reads = {name: sorted({v for f, v in needed if f == name}) for name in runners}
     read_vr = {name: ports[name].vrs(vs) for name, vs in reads.items()}
 
     def read(name):
