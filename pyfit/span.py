@@ -15,6 +15,7 @@ import numpy as np
 
 from . import plots
 from .cosim import Connection, cosimulate
+from .fmu import FmuRunner
 
 CONNECTIONS = [Connection("span.y_d", "damper.x_base", "span.v_d"),
                Connection("span.v_d", "damper.v_base", "span.a_d"),
@@ -52,7 +53,8 @@ def mode_decay(span_fmu, damper_fmu, mode: int, x_d: float, amplitude: float = 5
     """Free decay of `mode` (antinode amplitude [m]) over `periods` of its frequency, damper at x_d [m]."""
     sp = {"exc_type": 0, "x_d": x_d, f"q[{mode}]": amplitude, **(span_params or {})}
     dp = {"m_c": 0.0, **(damper_params or {})}
-    L, T, m_l = (sp.get(k, d) for k, d in (("L", 30.0), ("T", 28000.0), ("m_l", 1.628)))
+    span_fmu = span_fmu if isinstance(span_fmu, FmuRunner) else FmuRunner(str(span_fmu))
+    L, T, m_l, zeta = (float(sp.get(k, span_fmu.variables[k].start)) for k in ("L", "T", "m_l", "zeta"))
     f = mode * np.sqrt(T / m_l) / (2 * L)
     stop = step * max(1, int(round(periods / f / step)))
     r = cosimulate({"span": span_fmu, "damper": damper_fmu}, CONNECTIONS, stop, step,
@@ -61,7 +63,6 @@ def mode_decay(span_fmu, damper_fmu, mode: int, x_d: float, amplitude: float = 5
     w_damper = float(np.sum(0.5 * (power[1:] + power[:-1])) * step)  # trapezoidal rule
     loss = float(r["span.E"][0] - r["span.E"][-1])
     w_self = float(r["span.W_self"][-1])
-    zeta = sp.get("zeta", 0.002)
     return ModeDecay(mode, f, x_d, float(r["span.E"][0]), loss, w_self, w_damper, zeta,
                      zeta * (w_self + w_damper) / w_self)
 
