@@ -54,32 +54,30 @@ def _split(ref: str, fmus: dict) -> tuple[str, str]:
     return fmu, var
 
 
-class _Port:
-    """Fast get/set of one FMU's real variables through the raw FMI functions."""
+class _Vars:
+    """A fixed list of one FMU's real variables, read and written through the raw FMI functions with
+    buffers allocated once (this runs at every communication step)."""
 
-    def __init__(self, runner: FmuRunner):
+    def __init__(self, runner: FmuRunner, names: list[str]):
         self.fmu = runner._instance()
         self.comp = self.fmu.component
-        self.vars = runner.variables
-        md = runner.model_description
-        self.interpolates = bool(md.coSimulation.canInterpolateInputs)
+        self.names = names
+        self.n = len(names)
+        self.vr = (ctypes.c_uint * self.n)(*[runner.variables[v].valueReference for v in names])
+        self.buf = (ctypes.c_double * self.n)()
+        self.order = (ctypes.c_int * self.n)(*([1] * self.n))
 
-    def vrs(self, names):
-        return (ctypes.c_uint * len(names))(*[self.vars[n].valueReference for n in names])
+    def get(self) -> dict[str, float]:
+        self.fmu.fmi2GetReal(self.comp, self.vr, self.n, self.buf)
+        return dict(zip(self.names, self.buf[:]))
 
-    def get(self, vr, n):
-        buf = (ctypes.c_double * n)()
-        self.fmu.fmi2GetReal(self.comp, vr, n, buf)
-        return np.array(buf[:])
+    def set(self, values):
+        self.buf[:] = values
+        self.fmu.fmi2SetReal(self.comp, self.vr, self.n, self.buf)
 
-    def set(self, vr, values):
-        n = len(values)
-        self.fmu.fmi2SetReal(self.comp, vr, n, (ctypes.c_double * n)(*values))
-
-    def set_slopes(self, vr, slopes):
-        n = len(slopes)
-        order = (ctypes.c_int * n)(*([1] * n))
-        self.fmu.fmi2SetRealInputDerivatives(self.comp, vr, n, order, (ctypes.c_double * n)(*slopes))
+    def set_slopes(self, slopes):
+        self.buf[:] = slopes
+        self.fmu.fmi2SetRealInputDerivatives(self.comp, self.vr, self.n, self.order, self.buf)
 
 
 def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], stop_time: float, step: float,
@@ -109,7 +107,6 @@ def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], 
     if len(set(targets)) != len(targets):
         raise ValueError("an input is driven by more than one connection")
 
-    ports = {}
     for name, r in runners.items():
         r.check_parameters(params.get(name, {}))
         fmu = r._instance()
@@ -117,29 +114,24 @@ def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], 
         fmu.setupExperiment(tolerance=tolerance, startTime=0.0)
         r._apply(fmu, params.get(name, {}))
         fmu.enterInitializationMode()
-        ports[name] = _Port(r)
     # every output any connection or the record reads, per FMU, read in one call
     needed = [src for src, _, _ in conns] + [d for _, _, d in conns if d] + rec
-    reads = {name: sorted({v for f, v in needed if f == name}) for name in runners}
-    read_vr = {name: ports[name].vrs(vs) for name, vs in reads.items()}
-
-    def read(name):
-        vals = ports[name].get(read_vr[name], len(reads[name]))
-        return dict(zip(reads[name], vals))
-
-    inputs_of = {name: [(s, (t[1]), d) for s, t, d in conns if t[0] == name] for name in runners}
-    in_vr = {name: ports[name].vrs([t for _, t, _ in inputs_of[name]]) for name in runners}
+    reads = {name: _Vars(r, sorted({v for f, v in needed if f == name})) for name, r in runners.items()}
+    inputs_of = {name: [(s, d) for s, t, d in conns if t[0] == name] for name in runners}
+    writes = {name: _Vars(r, [t[1] for _, t, _ in conns if t[0] == name]) for name, r in runners.items()}
+    interpolates = {name: bool(r.model_description.coSimulation.canInterpolateInputs)
+                    for name, r in runners.items()}
 
     # initial values: two fixed-point sweeps over the connections (direct feedthrough at t = 0)
-    now = {name: read(name) for name in runners}
+    now = {name: reads[name].get() for name in runners}
     for _ in range(2):
         for name in runners:
             if inputs_of[name]:
-                ports[name].set(in_vr[name], [now[s[0]][s[1]] for s, _, _ in inputs_of[name]])
-        now = {name: read(name) for name in runners}
+                writes[name].set([now[s[0]][s[1]] for s, _ in inputs_of[name]])
+        now = {name: reads[name].get() for name in runners}
     for name in runners:
         runners[name]._instance().exitInitializationMode()
-    now = {name: read(name) for name in runners}
+    now = {name: reads[name].get() for name in runners}
     prev = now
     out = np.empty((n + 1, len(rec)))
     out[0] = [now[f][v] for f, v in rec]
@@ -150,7 +142,7 @@ def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], 
         for name in runners:
             if inputs_of[name]:
                 values, slopes = [], []
-                for (sf, sv), _, d in inputs_of[name]:
+                for (sf, sv), d in inputs_of[name]:
                     if scheme == "gauss-seidel" and sf in new:  # source already at t + h
                         if extrapolation == "linear":  # interpolate between t and t + h
                             values.append(now[sf][sv])
@@ -164,15 +156,14 @@ def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], 
                             slopes.append(now[d[0]][d[1]])
                         else:
                             slopes.append((now[sf][sv] - prev[sf][sv]) / step if k else 0.0)
-                p = ports[name]
-                p.set(in_vr[name], values)
-                if extrapolation == "linear" and p.interpolates:
-                    p.set_slopes(in_vr[name], slopes)
-            p = ports[name]
-            status = p.fmu.fmi2DoStep(p.comp, t, step, 1)
+                writes[name].set(values)
+                if extrapolation == "linear" and interpolates[name]:
+                    writes[name].set_slopes(slopes)
+            w = reads[name]
+            status = w.fmu.fmi2DoStep(w.comp, t, step, 1)
             if status != 0:
                 raise RuntimeError(f"FMU '{name}' failed in the step from t = {t:g} s (status {status})")
-            new[name] = read(name)
+            new[name] = w.get()
         prev, now = now, new
         out[k + 1] = [now[f][v] for f, v in rec]
     for r in runners.values():

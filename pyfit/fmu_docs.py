@@ -14,7 +14,7 @@ STEP = 1e-3  # s, output interval of the reference runs and spacing of their (li
 STOP = 0.5  # s
 
 
-def _motion(exc: Excitation, t: np.ndarray, names: tuple[str, ...]) -> dict[str, np.ndarray]:
+def motion_with_derivatives(exc: Excitation, t: np.ndarray, names: tuple[str, ...]) -> dict[str, np.ndarray]:
     """A prescribed motion and its exact first and second derivatives on the grid t."""
     ts = ca.SX.sym("t")
     x = exc(ts)
@@ -30,15 +30,17 @@ CLAMP_SINE = Excitation(kind=1, amplitude=5e-4, f_start=12.0, t_ramp=0.1)
 # element -> (what the reference run does, input builder(t) or None, parameters, recorded outputs)
 REFERENCE_RUNS = {
     "BoucWenElement": ("relative motion s = 2 mm sin(2π·10 Hz·t), default parameters",
-                       lambda t: _motion(SINE_2MM, t, ("s", "v")), {}, ["f", "df", "z"]),
+                       lambda t: motion_with_derivatives(SINE_2MM, t, ("s", "v")), {}, ["f", "df", "z"]),
     "BoucWenNormalizedElement": ("relative motion s = 2 mm sin(2π·10 Hz·t), default parameters",
-                                 lambda t: _motion(SINE_2MM, t, ("s", "v")), {}, ["f", "df", "z"]),
+                                 lambda t: motion_with_derivatives(SINE_2MM, t, ("s", "v")), {},
+                                 ["f", "df", "z"]),
     "CubicSpringElement": ("relative motion s = 2 mm sin(2π·10 Hz·t), k3 = 1e6 N/m³",
-                           lambda t: _motion(SINE_2MM, t, ("s", "v")), {}, ["f"]),
+                           lambda t: motion_with_derivatives(SINE_2MM, t, ("s", "v")), {}, ["f"]),
     "MassSpringDamper": ("built-in linear force sweep 120 N, 0 → 60 Hz at 0.5 Hz/s, input f = 0", None, {},
                          ["y", "v", "a"]),
     "DamperElement": ("clamp motion 0.5 mm sin(2π·12 Hz·t) with a 0.1 s ramp-in, default damper",
-                      lambda t: _motion(CLAMP_SINE, t, ("x_base", "v_base", "a_base")), {}, ["F_clamp", "x1", "x2"]),
+                      lambda t: motion_with_derivatives(CLAMP_SINE, t, ("x_base", "v_base", "a_base")), {},
+                      ["F_clamp", "x1", "x2"]),
     "ConductorSpan": ("built-in shaker sine 5 N at 10 Hz at x_e = 14.1 m, input F_clamp = 0", None, {},
                       ["y_d", "v_d", "a_d", "y_e", "E"]),
 }

@@ -75,6 +75,9 @@ class Objective:
         self.use_inputs = use_inputs
         self.input_upsample = int(input_upsample)
         self._inputs = self._fine_inputs(input_periodic) if use_inputs else None
+        self._input_time = (np.arange(len(next(iter(self._inputs.values())))) / (measurement.sample_rate_hz
+                                                                                  * self.input_upsample)
+                            if self._inputs else None)
         self.fs = measurement.sample_rate_hz
         self.t = measurement.t - measurement.t[0]
         self.first = int(round(warmup_s * self.fs))
@@ -125,10 +128,8 @@ class Objective:
         """The FMU's response on the measurement's time grid."""
         q = self.input_upsample if self.use_inputs else 1
         dt = 1.0 / (self.fs * q)
-        inputs = self._inputs
-        input_time = np.arange(len(next(iter(inputs.values())))) * dt if inputs else None
         res = self.runner.simulate(self.t[-1], dt, outputs or [c.output for c in self.channels], self.params(x),
-                                   inputs=inputs, input_time=input_time, tolerance=self.tolerance)
+                                   inputs=self._inputs, input_time=self._input_time, tolerance=self.tolerance)
         if q > 1:
             res = SimulationResult(res.time[::q], {k: v[::q] for k, v in res.values.items()}, res.ok, res.message)
         return res

@@ -9,6 +9,7 @@ under a modal (wind-like) force scales as 1 / damping, so the reduction is zeta_
 """
 from __future__ import annotations
 
+import pathlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -74,9 +75,7 @@ def reduction_table(span_fmu, damper_fmu, modes, positions, **kw) -> list[ModeDe
 
 def write_report(rows: list[ModeDecay], out_dir) -> None:
     """reduction.md (table per mode and position), reduction.csv and reduction.png into out_dir."""
-    import pathlib
-
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # only when a report is written
 
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
