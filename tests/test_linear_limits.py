@@ -3,6 +3,7 @@ computations (analytic formulas, numpy eigenvalues of independently assembled ma
 import numpy as np
 import pytest
 
+from damper_matrices import clamped_matrices
 from pyfit.modal import free_decay_modes, state_space_modes
 
 DT = 5e-4
@@ -48,27 +49,8 @@ def test_two_dof_linear_modes_match_numpy_eigenvalues(runner, config):
         assert e.zeta == pytest.approx(r.zeta, rel=1e-2)
 
 
-def _damper_matrices():
-    """Independent assembly of design section 1.3: DOFs [x1, phi1, xc, phic, x2, phi2], clamp held."""
-    EI, mu, L1, L2 = 10.0, 0.3, 0.17, 0.12
-    K = np.zeros((6, 6))
-    M = np.zeros((6, 6))
-    for i, L in ((0, L1), (2, L2)):
-        K[i:i + 4, i:i + 4] += EI / L**3 * np.array(
-            [[12, 6 * L, -12, 6 * L], [6 * L, 4 * L**2, -6 * L, 2 * L**2],
-             [-12, -6 * L, 12, -6 * L], [6 * L, 2 * L**2, -6 * L, 4 * L**2]])
-        M[i:i + 4, i:i + 4] += mu * L / 420 * np.array(
-            [[156, 22 * L, 54, -13 * L], [22 * L, 4 * L**2, 13 * L, -3 * L**2],
-             [54, 13 * L, 156, -22 * L], [-13 * L, -3 * L**2, -22 * L, 4 * L**2]])
-    for node, m, J, a, side in ((0, 0.8, 1.68e-3, 0.0325, -1), (4, 0.6, 1.26e-3, 0.0325, 1)):
-        M[node:node + 2, node:node + 2] += [[m, side * m * a], [side * m * a, J + m * a * a]]
-    free = [0, 1, 4, 5]
-    M, K = M[np.ix_(free, free)], K[np.ix_(free, free)]
-    return M, 2.0 * M + 2e-4 * K, K
-
-
 def test_damper_reference_matrices_have_the_design_frequencies():
-    M, _, K = _damper_matrices()
+    M, _, K = clamped_matrices()
     undamped = np.sqrt(np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)) / (2 * np.pi)
     np.testing.assert_allclose(undamped, [10.1, 17.3, 79.0, 125.0], rtol=0.01)
 
@@ -89,7 +71,7 @@ def test_damper_linear_modes_match_independent_matrices(runner):
     keep = res.time > 2 * T
     Y = np.column_stack([res[o][keep] for o in ("x1", "x2", "phi1", "phi2")])
     est = free_decay_modes(Y, DT, 4)
-    ref = state_space_modes(*_damper_matrices())
+    ref = state_space_modes(*clamped_matrices())
     assert len(est) == 4
     for e, r in zip(est, ref):
         assert e.f_d == pytest.approx(r.f_d, rel=0.005)

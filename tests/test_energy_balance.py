@@ -1,0 +1,83 @@
+"""Energy balance method: the steady-amplitude solver against independent polynomial roots, and the damper
+power the damper FMU gives against the harmonic solution of independently assembled matrices."""
+import math
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from damper_matrices import clamp_power
+from pyfit import energy_balance as eb
+
+DRAKE_LAB = eb.Conductor(eb.DRAKE_DIAMETER, 1.628, 28e3, 30.0, 0.002)
+DRAKE_FIELD = eb.Conductor(eb.DRAKE_DIAMETER, 1.628, 28e3, 300.0, 2e-4)
+
+
+def _first_positive_root(coefficients):
+    """Smallest positive real root of a polynomial in eta = Y/D (numpy.roots: an independent solver)."""
+    r = np.roots(coefficients)
+    return min(x.real for x in r if abs(x.imag) < 1e-12 and x.real > 0)
+
+
+@pytest.mark.parametrize("conductor", [DRAKE_LAB, DRAKE_FIELD])
+def test_amplitude_without_damper_is_the_root_of_the_cigre_polynomial(conductor):
+    # viscous self-damping: 1/2 zeta m w^3 Y^2 L = f^3 D^4 fnc(Y/D) L  ->  fnc(eta) = K eta^2
+    D = conductor.diameter
+    K = 0.5 * conductor.zeta * conductor.mass_per_length * (2 * np.pi) ** 3 / D ** 2
+    a3, a2, a1, a0 = eb.CIGRE_FNC
+    eta = _first_positive_root([a3, a2 - K, a1, a0])
+    for f in (3.0, 17.0, 50.0):  # both powers scale with f^3: Y/D does not depend on f
+        assert eb.steady_amplitude(f, conductor) / D == pytest.approx(eta, rel=1e-8)
+    # and the balance holds there
+    Y = eta * D
+    assert eb.wind_power(10.0, Y, conductor) == pytest.approx(eb.self_damping_power(10.0, Y, conductor), rel=1e-8)
+
+
+def test_amplitude_with_a_viscous_damper_is_the_root_of_the_balance_polynomial():
+    c, f, x_d, c_d = DRAKE_FIELD, 12.0, 1.0, 20.0  # damper: a dashpot of 20 N·s/m at 1 m from the end
+    w, D, L = 2 * np.pi * f, DRAKE_FIELD.diameter, DRAKE_FIELD.span_length
+    s = math.sin(2 * math.pi * x_d / float(c.wavelength(f)))
+    quad = (0.5 * c.zeta * c.mass_per_length * w ** 3 * L + 0.5 * c_d * w ** 2 * s ** 2) * D ** 2 / (f ** 3 * D ** 4 * L)
+    a3, a2, a1, a0 = eb.CIGRE_FNC
+    eta = _first_positive_root([a3, a2 - quad, a1, a0])
+    Y = eb.steady_amplitude(f, c, lambda a: 0.5 * c_d * w ** 2 * a ** 2, x_d)
+    assert Y / D == pytest.approx(eta, rel=1e-8)
+    assert Y < 0.5 * eb.steady_amplitude(f, c)  # the dashpot takes most of the wind's power
+
+
+def test_damper_table_interpolates_power_law_exactly():
+    amps = np.geomspace(1e-5, 1e-2, 7)
+    table = eb.DamperPowerTable(np.array([10.0]), amps, (3.0 * amps ** 2.5)[None, :])
+    for a in (2e-5, 3.3e-4, 9e-3):
+        assert table.at(0, a) == pytest.approx(3.0 * a ** 2.5, rel=1e-12)
+    assert table.at(0, 1e-6) == pytest.approx(3.0 * 1e-5 ** 2.5 * 0.01, rel=1e-12)  # ∝ a² below the table
+    assert math.isnan(table.at(0, 2e-2))
+    table.power[0, 4] = np.nan  # a failed run ends the valid range
+    assert table.valid_amplitude(0) == amps[3] and math.isnan(table.at(0, amps[4] * 1.1))
+
+
+def test_damper_fmu_power_matches_independent_harmonic_solution(fmu_dir):
+    # linear damper (Bouc-Wen and cubic off): mean power at the clamp vs the 6-DOF harmonic solution.
+    # Tolerance: the steady state is averaged over whole periods after 6 s; the slowest transient (10.1 Hz,
+    # zeta 2.2 %) has decayed to exp(-0.022 * 63.5 * 6) = 2e-4 of its start by then.
+    linear = {"k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0}
+    freqs, amps = [5.0, 10.0, 17.3, 30.0], [5e-4]
+    table = eb.damper_power_table(fmu_dir / "DamperElement.fmu", freqs, amps, linear, workers=1, progress=False)
+    for i, f in enumerate(freqs):
+        assert table.power[i, 0] == pytest.approx(clamp_power(f, amps[0]), rel=1e-3), f
+    assert np.nanmax(table.drift) < 1e-3
+
+
+def test_energy_balance_script_writes_the_report(fmu_dir, tmp_path):
+    root = pathlib.Path(__file__).resolve().parents[1]
+    run = subprocess.run([sys.executable, str(root / "scripts" / "energy_balance.py"), "--fmus", str(fmu_dir),
+                          "--out", str(tmp_path), "--case", "300:0.0002", "--freqs", "17", "17", "1",
+                          "--amplitudes", "1e-5", "1e-2", "4", "--positions", "1.0", "--workers", "1"],
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    rows = np.loadtxt(tmp_path / "span_300m_zeta_0.0002.csv", delimiter=",", skiprows=1)
+    # at the damper's second resonance the damper takes the amplitude far below the bare span's
+    assert rows[0] == pytest.approx(17.0) and rows[3] < 0.1 * rows[2]
+    assert (tmp_path / "span_300m_zeta_0.0002.png").is_file() and (tmp_path / "damper_power.csv").is_file()
