@@ -64,3 +64,21 @@ def simulate_validation(runner, signal: ValidationSignal, upsample: int = 20, pe
         n = len(signal.u)
         return y[(periods - 1) * n:periods * n]
     return y[:len(signal.u)]
+
+
+def write_dataset(out_dir, folder: pathlib.Path = DEFAULT_DIR) -> pathlib.Path:
+    """The two official signals as a design-section-5 dataset (for the gap-diagnosis demonstration that
+    the data README allows: calibrate on the multisine, judge on the sweep)."""
+    from .data import write_measurement
+
+    out = pathlib.Path(out_dir)
+    for name in ("multisine", "sinesweep"):
+        s = load(name, folder)
+        t = np.arange(len(s.u)) / FS_HZ
+        rms = float(np.sqrt(np.mean(s.u**2)))
+        exc = {"kind": "multisine", "samples_per_period": len(s.u), "periods": 1} if s.periodic else \
+            {"kind": "sweep", "description": "40 sin(2 pi (18 t + t^2/12)), 18 -> 52 Hz"}
+        write_measurement(out / f"{name}.csv", "SDOFBoucWen", t, {"u": (s.u, "N", "u")}, {"y": (s.y, "m", "y")},
+                          level=f"{name}, force RMS {rms:.1f} N", level_value=rms, excitation=exc,
+                          notes="official Bouc-Wen benchmark validation signal (Noel & Schoukens 2016)")
+    return out

@@ -90,17 +90,55 @@ def _ops(t):
     return _Casadi if isinstance(t, (ca.SX, ca.MX)) else np
 
 
-def multisine(n_samples: int, fs: float, f_min: float, f_max: float, rms: float, seed: int = 0) -> np.ndarray:
+def multisine(n_samples: int, fs: float, f_min: float, f_max: float, rms: float, seed: int = 0,
+              odd: bool = False) -> np.ndarray:
     """One period of a random-phase multisine with flat amplitude spectrum on [f_min, f_max] Hz, scaled to rms.
 
+    odd=True: a random-odd multisine (only odd multiples of fs/n_samples, one of every four left out), so
+    that odd and even nonlinear distortion show on the lines left unexcited (Pintelon & Schoukens).
     Periodic with n_samples per period, so a whole number of periods is leakage-free.
     """
     rng = np.random.default_rng(seed)
     spec = np.zeros(n_samples // 2 + 1, complex)
     f = np.fft.rfftfreq(n_samples, 1 / fs)
     band = (f >= f_min) & (f <= f_max) & (f > 0)
+    if odd:  # odd lines only, one left out at random in every group of four: detection lines
+        lines = np.flatnonzero(band & (np.arange(len(f)) % 2 == 1))
+        band[:] = False
+        for g in range(0, len(lines), 4):
+            group = lines[g:g + 4]
+            band[np.delete(group, rng.integers(len(group))) if len(group) == 4 else group] = True
     if not band.any():
         raise ValueError(f"no frequency line of a {n_samples}-sample period at {fs} Hz lies in [{f_min}, {f_max}]")
     spec[band] = np.exp(2j * np.pi * rng.random(band.sum()))
     u = np.fft.irfft(spec, n_samples)
     return u * rms / np.sqrt(np.mean(u**2))
+
+
+class PeriodicSignal:
+    """A band-limited periodic signal given by one period of samples, evaluated at any time t [s] as the
+    sum of its DFT lines (numpy arrays or CasADi expressions): the exact continuous-time input an
+    integrator with its own steps needs."""
+
+    kind = -1  # not a built-in FMU excitation
+
+    def __init__(self, period_samples: np.ndarray, fs: float):
+        n = len(period_samples)
+        spec = np.fft.rfft(period_samples) / n
+        lines = np.flatnonzero(np.abs(spec) > 1e-12 * np.abs(spec).max())
+        self.mean = float(spec[0].real)
+        lines = lines[lines > 0]
+        scale = np.where(2 * lines == n, 1.0, 2.0)
+        self.amplitudes = scale * np.abs(spec[lines])
+        self.omegas = 2 * np.pi * lines * fs / n
+        self.phases = np.angle(spec[lines])
+
+    def __call__(self, t):
+        if isinstance(t, (ca.SX, ca.MX)):
+            out = self.mean
+            for a, w, p in zip(self.amplitudes, self.omegas, self.phases):
+                out = out + a * ca.cos(w * t + p)
+            return out
+        t = np.asarray(t, float)
+        return self.mean + np.sum(self.amplitudes[:, None] * np.cos(np.outer(self.omegas, t.ravel())
+                                                                     + self.phases[:, None]), axis=0).reshape(t.shape)

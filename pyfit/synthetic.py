@@ -37,11 +37,12 @@ class MultisineInput:
     samples_per_period: int
     periods: int
     seed: int = 0
+    odd: bool = False  # random-odd multisine (detection lines for odd/even distortion)
 
     def __call__(self, fs: float) -> np.ndarray:
         """All periods at the sensor rate fs [Hz]."""
-        return np.tile(multisine(self.samples_per_period, fs, self.f_min, self.f_max, self.rms, self.seed),
-                       self.periods)
+        return np.tile(multisine(self.samples_per_period, fs, self.f_min, self.f_max, self.rms, self.seed,
+                                 self.odd), self.periods)
 
 
 @dataclass

@@ -1,0 +1,182 @@
+"""The diagnosis run: dataset -> nominal calibration -> where (gap on held-out files) -> which (screening,
+refits, ranking) -> how far (shrink) -> report. Finished fits are stored under OUT/fits/ with a key of the
+dataset and settings, so an interrupted diagnosis resumes from them."""
+from __future__ import annotations
+
+import hashlib
+import json
+import pathlib
+from dataclasses import asdict, dataclass, fields
+
+import numpy as np
+
+from ..batch import map_tasks
+from ..data import MeasurementError, read_dataset
+from ..fmu import FmuRunner
+from ..run_example import ensure_fmu
+from ..tomlfile import read_toml
+from . import localise
+from . import simulate as sim
+from .attribute import Fit, data_scale, effect_task, frf_linear_guess, nominal_task, run_fit, screen
+from .systems import get_system
+
+
+class DiagnoseError(ValueError):
+    """Bad input to a diagnosis; names the file and field and what is allowed."""
+
+
+@dataclass
+class DiagnoseConfig:
+    """Settings of a diagnosis (all optional)."""
+
+    effects: list | None = None  # candidate effects to test (default: all of the system's)
+    calibration: list | None = None  # file stems to calibrate on (default: every level but the middle one)
+    bands_hz: list | None = None  # [[lo, hi], ...] (default: 8 log-spaced bands over the excited range)
+    nominal_budget: int = 60  # FMU evaluations of the nominal calibration
+    refit_budget: int = 120  # FMU evaluations per refit with an effect
+    upsample: int = 4  # FMU input grid = sensor rate x upsample
+    min_gap: float = 0.005  # NRMSE a gap must exceed beyond the noise floor to count
+    noise_factor: float = 1.2  # ... and the noise floor times this
+    close_points: float = 15.0  # runner-up within this many score points: reported as close
+    min_shrink_pct: float = 50.0  # the best effect must shrink the gap by this much to be chosen
+
+
+_TYPES = {"effects": (list,), "calibration": (list,), "bands_hz": (list,), "nominal_budget": (int,),
+          "refit_budget": (int,), "upsample": (int,)}  # the others: int or float
+
+
+def load_config(path) -> DiagnoseConfig:
+    """A DiagnoseConfig from the [diagnose] table of a TOML file; one clear error per problem."""
+    path = pathlib.Path(path)
+    raw = read_toml(path, DiagnoseError)
+    if set(raw) - {"diagnose"}:
+        raise DiagnoseError(f"{path}: [{sorted(set(raw) - {'diagnose'})[0]}] unknown table; allowed: [diagnose]")
+    table = raw.get("diagnose", {})
+    allowed = {f.name for f in fields(DiagnoseConfig)}
+    for key, value in table.items():
+        if key not in allowed:
+            raise DiagnoseError(f"{path}: [diagnose] {key}: unknown key; allowed: {', '.join(sorted(allowed))}")
+        want = _TYPES.get(key, (int, float))
+        if not isinstance(value, want) or isinstance(value, bool):
+            raise DiagnoseError(f"{path}: [diagnose] {key} = {value!r}: expected "
+                                f"{' or '.join(w.__name__ for w in want)}")
+    cfg = DiagnoseConfig(**table)
+    for lo_hi in cfg.bands_hz or []:
+        if not (isinstance(lo_hi, list) and len(lo_hi) == 2 and 0 <= lo_hi[0] < lo_hi[1]):
+            raise DiagnoseError(f"{path}: [diagnose] bands_hz: {lo_hi!r} is not [lo, hi] with 0 <= lo < hi")
+    return cfg
+
+
+def _load(data_dir, system, cfg: DiagnoseConfig):
+    """Records of the dataset, validated, split into calibration and held-out."""
+    data_dir = pathlib.Path(data_dir)
+    try:
+        ms = read_dataset(data_dir)
+    except MeasurementError as exc:
+        raise DiagnoseError(str(exc)) from exc
+    missing = [p.name for p in sorted(data_dir.glob("*.csv")) if not p.with_suffix(".toml").is_file()]
+    if missing:
+        raise DiagnoseError(f"{data_dir / missing[0]}: no sidecar {pathlib.Path(missing[0]).stem}.toml")
+    if len(ms) < 2:
+        raise DiagnoseError(f"{data_dir}: a diagnosis needs at least two files (one to calibrate on, one held "
+                            f"out); found {len(ms)}")
+    for m in ms:
+        if m.model != system.fmu:
+            raise DiagnoseError(f"{m.path.with_suffix('.toml')}: model = '{m.model}' but --model {system.name} "
+                                f"expects '{system.fmu}'")
+        if abs(m.sample_rate_hz - ms[0].sample_rate_hz) > 1e-6 * ms[0].sample_rate_hz:
+            raise DiagnoseError(f"{m.path.with_suffix('.toml')}: sample_rate_hz = {m.sample_rate_hz:g} but "
+                                f"{ms[0].path.name} has {ms[0].sample_rate_hz:g}; a dataset needs one rate")
+    unknown = [e for e in (cfg.effects or []) if e not in system.effects]
+    if unknown:
+        raise DiagnoseError(f"effects: '{unknown[0]}' unknown for {system.name}; allowed: "
+                            f"{', '.join(system.effects)}")
+    records = [sim.record_of(m) for m in ms]
+    names = [r.name for r in records]
+    if cfg.calibration:
+        bad = [c for c in cfg.calibration if c not in names]
+        if bad:
+            raise DiagnoseError(f"calibration: no file '{bad[0]}' in {data_dir}; files: {', '.join(names)}")
+        cal = [r for r in records if r.name in cfg.calibration]
+    else:
+        levels = sorted({r.level_value for r in records})
+        middle = levels[len(levels) // 2] if len(levels) >= 3 else None
+        cal = [r for r in records if r.level_value != middle] if middle is not None else records[:1]
+    held = [r for r in records if r not in cal]
+    if not held or not cal:
+        raise DiagnoseError(f"calibration: the split leaves {'no held-out' if not held else 'no calibration'} file")
+    digest = hashlib.sha256()
+    for m in ms:
+        digest.update(m.path.read_bytes())
+        digest.update(m.path.with_suffix(".toml").read_bytes())
+    return records, cal, held, digest.hexdigest()[:16]
+
+
+def _fit_and_store(job) -> Fit:
+    """Run one fit (in a worker) and store it at once, so an interrupted diagnosis keeps it."""
+    task, path, key = job
+    fit = run_fit(task)
+    pathlib.Path(path).write_text(json.dumps({"key": key, "fit": fit.to_json()}, indent=1))
+    return fit
+
+
+def _stored(path: pathlib.Path, key: str) -> Fit | None:
+    if path.is_file():
+        d = json.loads(path.read_text())
+        if d.get("key") == key:
+            return Fit(**d["fit"])
+    return None
+
+
+def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, fmu_dir="fmus",
+             workers: int | None = None, progress: bool = True) -> dict:
+    """Diagnose the dataset against the nominal model `model` ('sdof'); writes OUT/report.json,
+    OUT/report.md and figures; returns the report. When the nominal model already fits the held-out files
+    within the noise floor, no effect is refitted (verdict 'no significant gap')."""
+    from . import report
+
+    cfg = cfg or DiagnoseConfig()
+    system = get_system(model)
+    records, cal, held, data_key = _load(data_dir, system, cfg)
+    out = pathlib.Path(out_dir)
+    (out / "fits").mkdir(parents=True, exist_ok=True)
+    fmu = str(ensure_fmu(system.fmu, pathlib.Path(fmu_dir)))
+    settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in ("min_gap", "noise_factor",
+                                                                             "close_points", "min_shrink_pct")},
+                          sort_keys=True)
+    key = hashlib.sha256((data_key + settings + model + ",".join(r.name for r in cal)).encode()).hexdigest()[:16]
+
+    nominal = _stored(out / "fits" / "nominal.json", key)
+    if nominal is None:
+        task = nominal_task(system, fmu, cal, frf_linear_guess(cal), cfg.nominal_budget, cfg.upsample)
+        nominal = _fit_and_store((task, out / "fits" / "nominal.json", key))
+    scale = data_scale(cal, nominal.params["k"])
+    runner = FmuRunner(fmu)
+    sims = {"nominal": {r.name: sim.simulate(runner, r, nominal.params, cfg.upsample) for r in records}}
+    bands = [tuple(b) for b in cfg.bands_hz] if cfg.bands_hz else localise.default_bands(records)
+    gap = report.nominal_gap(sims["nominal"], records, held, bands, cfg)
+    screening, fits = {}, {}
+    if gap["significant"]:  # otherwise the nominal model explains the data within its noise: nothing to attribute
+        screening_path = out / "fits" / "screening.json"
+        stored = json.loads(screening_path.read_text()) if screening_path.is_file() else {}
+        if stored.get("key") == key:
+            screening = stored["fractions"]
+        else:
+            screening = screen(system, fmu, cal, nominal, scale, cfg.upsample)
+            screening_path.write_text(json.dumps({"key": key, "fractions": screening}, indent=1))
+        jobs = []
+        for name in cfg.effects or list(system.effects):
+            path = out / "fits" / f"{name}.json"
+            fits[name] = _stored(path, key)
+            if fits[name] is None:
+                jobs.append((effect_task(system, system.effects[name], fmu, cal, nominal, scale, cfg.refit_budget,
+                                         cfg.upsample), str(path), key))
+        for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="refits"):
+            fits[fit.effect] = fit
+        for name, f in fits.items():
+            sims[name] = {r.name: sim.simulate(runner, r, f.params, cfg.upsample) for r in records}
+    result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap)
+    result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample)
+    runner.close()
+    report.write(result, records, held, sims, bands, out)
+    return result

@@ -1,0 +1,119 @@
+"""Where a model misfits: NRMSE of the outputs overall and split by frequency band, amplitude level,
+channel, harmonic line class (odd/even detection lines of an odd multisine) and hysteresis-loop region;
+the noise floor estimated from the data itself. Plain numpy on measured and simulated signals.
+
+All split metrics are contributions: their squares add up to the squared NRMSE of the record, so they
+say where the residual's energy lies.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .simulate import Record
+
+LOOP_REGIONS = ("centre, loading", "centre, unloading", "tips, loading", "tips, unloading")
+
+
+def nrmse(sim: dict, rec: Record) -> float:
+    """sqrt(mean over channels of RMS(y_sim - y)^2 / RMS(y)^2)."""
+    return float(np.sqrt(np.mean([np.mean((sim[k] - y) ** 2) / np.mean(y**2) for k, y in rec.outputs.items()])))
+
+
+def _period_spectra(x: np.ndarray, spp: int) -> np.ndarray:
+    """DFT of every period (rows), or of the whole record when not periodic (spp = 0)."""
+    if spp:
+        return np.fft.rfft(x.reshape(-1, spp), axis=1)
+    return np.fft.rfft(x)[None, :]
+
+
+def noise_floor(rec: Record) -> float:
+    """Noise NRMSE of the record estimated from the data: from the scatter between periods when there are
+    two or more; otherwise from the DFT lines the input does not excite (an upper bound: distortion lands
+    there too)."""
+    out = []
+    for k, y in rec.outputs.items():
+        spp = rec.samples_per_period
+        if spp and rec.n // spp >= 2:
+            var = float(np.mean(np.var(y.reshape(-1, spp), axis=0, ddof=1)))
+        else:
+            u = next(iter(rec.inputs.values()))
+            U, Y = np.fft.rfft(u), np.fft.rfft(y)
+            quiet = np.abs(U) ** 2 < 1e-8 * np.max(np.abs(U) ** 2)
+            quiet[0] = False
+            var = float(np.mean(np.abs(Y[quiet]) ** 2) / len(y)) if quiet.any() else 0.0
+        out.append(var / np.mean(y**2))
+    return float(np.sqrt(np.mean(out)))
+
+
+def by_band(sim: dict, rec: Record, bands: list[tuple[float, float]]) -> list[float]:
+    """Contribution of each band [Hz] to the NRMSE: sqrt(residual power in band / total output power)."""
+    res = []
+    for k, y in rec.outputs.items():
+        E, Y = np.fft.rfft(sim[k] - y), np.fft.rfft(y)
+        f = np.fft.rfftfreq(len(y), 1.0 / rec.fs)
+        total = np.sum(np.abs(Y) ** 2)
+        res.append([np.sum(np.abs(E[(f >= lo) & (f < hi)]) ** 2) / total for lo, hi in bands])
+    return [float(v) for v in np.sqrt(np.mean(res, axis=0))]
+
+
+def line_classes(rec: Record) -> dict[str, np.ndarray] | None:
+    """For a periodic record: masks over the DFT lines of one period: excited, odd and even detection
+    lines inside the excited band, and lines above it (harmonics). None when not periodic."""
+    spp = rec.samples_per_period
+    if not spp:
+        return None
+    U = np.abs(np.mean(_period_spectra(next(iter(rec.inputs.values())), spp), axis=0))
+    excited = U > 1e-3 * U.max()
+    idx = np.flatnonzero(excited)
+    k = np.arange(len(U))
+    inside = (k > idx[0]) & (k < idx[-1]) & ~excited
+    return {"excited": excited, "odd_detection": inside & (k % 2 == 1), "even_detection": inside & (k % 2 == 0),
+            "above_band": k > idx[-1]}
+
+
+def by_harmonic(sim: dict, rec: Record) -> dict | None:
+    """Residual contribution to the NRMSE on each line class (period-averaged spectra, so the periodic
+    misfit stays and noise averages down), with the noise floor of that class. None when not periodic."""
+    classes = line_classes(rec)
+    if classes is None:
+        return None
+    spp = rec.samples_per_period
+    periods = rec.n // spp
+    out = {name: {"misfit": 0.0, "noise": 0.0} for name in classes}
+    for k, y in rec.outputs.items():
+        E = np.mean(_period_spectra(sim[k] - y, spp), axis=0)
+        Yp = _period_spectra(y, spp)
+        total = np.sum(np.abs(np.mean(Yp, axis=0)) ** 2)
+        noise_line = np.var(Yp, axis=0, ddof=1) / periods if periods >= 2 else np.zeros(Yp.shape[1])
+        for name, mask in classes.items():
+            out[name]["misfit"] += float(np.sum(np.abs(E[mask]) ** 2) / total) / len(rec.outputs)
+            out[name]["noise"] += float(np.sum(noise_line[mask]) / total) / len(rec.outputs)
+    return {name: {key: float(np.sqrt(v)) for key, v in d.items()} for name, d in out.items()}
+
+
+def by_loop_region(sim: dict, rec: Record) -> dict[str, float]:
+    """Contribution to the NRMSE of four regions of the measured displacement-velocity loop: centre or
+    tips (|y| below or above half its peak), loading (moving away from 0) or unloading."""
+    out = {r: 0.0 for r in LOOP_REGIONS}
+    for k, y in rec.outputs.items():
+        v = np.gradient(y) * rec.fs
+        tips = np.abs(y) >= 0.5 * np.max(np.abs(y))
+        loading = y * v > 0
+        total = np.sum(y**2)
+        e2 = (sim[k] - y) ** 2
+        for name, mask in zip(LOOP_REGIONS, (~tips & loading, ~tips & ~loading, tips & loading, tips & ~loading)):
+            out[name] += float(np.sum(e2[mask]) / total) / len(rec.outputs)
+    return {r: float(np.sqrt(v)) for r, v in out.items()}
+
+
+def default_bands(records: list[Record], n: int = 8) -> list[tuple[float, float]]:
+    """n log-spaced bands over the lines the inputs excite (from 0.8x the lowest to 1.2x the highest)."""
+    lo, hi = np.inf, 0.0
+    for rec in records:
+        u = next(iter(rec.inputs.values()))
+        U = np.abs(np.fft.rfft(u))
+        f = np.fft.rfftfreq(len(u), 1.0 / rec.fs)
+        exc = f[(U > 1e-3 * U.max()) & (f > 0)]
+        lo, hi = min(lo, exc.min()), max(hi, exc.max())
+    edges = np.geomspace(0.8 * lo, min(1.2 * hi, records[0].fs / 2), n + 1)
+    return [(float(a), float(b)) for a, b in zip(edges[:-1], edges[1:])]

@@ -1,0 +1,218 @@
+"""How far: the gap on held-out files before and after each effect, the ranking, the verdict and the
+evidence; what would separate close candidates; report.json, report.md and figures."""
+from __future__ import annotations
+
+import json
+import pathlib
+
+import numpy as np
+
+from .. import plots
+from . import localise
+from . import simulate as sim
+
+
+def _rms_over(values) -> float:
+    return float(np.sqrt(np.mean(np.square(values))))
+
+
+def _gap(sims: dict, records, held, bands) -> dict:
+    """Gap metrics of one model's simulations: held-out overall, per band, channel, harmonic class, loop
+    region; per level over every file."""
+    hs = [r for r in held if sims[r.name] is not None]
+    failed = [r.name for r in held if sims[r.name] is None]
+    overall = _rms_over([localise.nrmse(sims[r.name], r) for r in hs]) if hs else float("inf")
+    by_band = np.sqrt(np.mean([np.square(localise.by_band(sims[r.name], r, bands)) for r in hs], axis=0)) \
+        if hs else np.full(len(bands), np.nan)
+    harmonic = [localise.by_harmonic(sims[r.name], r) for r in hs]
+    harmonic = [h for h in harmonic if h is not None]
+    loops = [localise.by_loop_region(sims[r.name], r) for r in hs]
+    return {
+        "overall": overall,
+        "failed_files": failed,
+        "by_band": [{"band_hz": list(b), "nrmse": float(v)} for b, v in zip(bands, by_band)],
+        "by_level": [{"file": r.name, "level": r.level, "level_value": r.level_value, "held_out": r in held,
+                      "nrmse": None if sims[r.name] is None else localise.nrmse(sims[r.name], r),
+                      "noise_floor": localise.noise_floor(r)} for r in records],
+        "by_channel": {k: _rms_over([np.sqrt(np.mean((sims[r.name][k] - r.outputs[k]) ** 2) / np.mean(r.outputs[k] ** 2))
+                                     for r in hs]) for k in records[0].outputs} if hs else {},
+        "by_harmonic": {c: {q: _rms_over([h[c][q] for h in harmonic]) for q in ("misfit", "noise")}
+                        for c in harmonic[0]} if harmonic else None,
+        "by_loop_region": {k: _rms_over([d[k] for d in loops]) for k in localise.LOOP_REGIONS} if loops else {},
+    }
+
+
+def _free_values(fit) -> dict:
+    out = {n: fit.params[n] for n in fit.free}
+    if fit.effect == "hysteresis":
+        out["beta (fixed)"] = fit.params["beta"]
+        out["beta*gamma"] = fit.params["beta"] * fit.params["gamma"]
+        out["beta*delta"] = fit.params["beta"] * fit.params["delta"]
+    return out
+
+
+def nominal_gap(sims: dict, records, held, bands, cfg) -> dict:
+    """The nominal model's gap (where), its noise floor from the held-out data, and whether the gap is
+    significant: larger than noise_factor x the floor and than the floor + min_gap."""
+    gap = _gap(sims, records, held, bands)
+    floor = _rms_over([localise.noise_floor(r) for r in held])
+    gap["noise_floor"] = floor
+    worst = int(np.nanargmax([b["nrmse"] for b in gap["by_band"]]))
+    gap["worst_band_hz"] = gap["by_band"][worst]["band_hz"]
+    gap["significant"] = bool(gap["overall"] > max(cfg.noise_factor * floor, floor + cfg.min_gap))
+    return gap
+
+
+def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap) -> dict:
+    """The report: verdict, chosen effect, gap (where), ranking (which, how far), evidence."""
+    floor, before, significant = gap["noise_floor"], gap["overall"], gap["significant"]
+    ranking = []
+    for name, fit in fits.items():
+        after = _gap(sims[name], records, held, bands)["overall"]
+        shrink = 100.0 * (before - after) / (before - floor) if before > floor else 0.0
+        ranking.append({"effect": name, "score": shrink - 5.0 * (fit.n_added - 1), "heldout_gap_before": before,
+                        "heldout_gap_after": after, "shrink_pct": shrink, "params": _free_values(fit),
+                        "n_added_params": fit.n_added, "screening_explained": screening.get(name),
+                        "calibration_nrmse": fit.calibration_nrmse, "evaluations": fit.evaluations,
+                        "wall_s": fit.wall_s})
+    ranking.sort(key=lambda d: -d["score"])
+    best = ranking[0] if ranking else None
+    if not significant:
+        verdict, chosen = "no significant gap", None
+    elif best and best["shrink_pct"] >= cfg.min_shrink_pct:
+        verdict, chosen = f"gap explained by {best['effect']}", best["effect"]
+    else:
+        verdict, chosen = "gap not explained by the candidate effects", None
+    close = (len(ranking) > 1 and significant and ranking[0]["score"] - ranking[1]["score"] < cfg.close_points)
+    levels = [d for d in gap["by_level"] if d["nrmse"] is not None]
+    evidence = []
+    if chosen:
+        sys_effect = system.effects[chosen]
+        rank_screen = sorted(screening, key=lambda k: -screening[k]).index(chosen) + 1
+        evidence = [
+            f"held-out NRMSE {before:.4f} -> {best['heldout_gap_after']:.4f} (noise floor {floor:.4f}): "
+            f"shrink {best['shrink_pct']:.1f} %",
+            f"screening: its sensitivity explains {100 * screening[chosen]:.1f} % of the nominal residual "
+            f"(rank {rank_screen} of {len(screening)})",
+            "nominal misfit by level: " + ", ".join(f"{d['level']}: {d['nrmse']:.3f}" for d in levels),
+            f"largest misfit in the band {gap['worst_band_hz'][0]:.1f}-{gap['worst_band_hz'][1]:.1f} Hz",
+            f"expected signature: {sys_effect.signature}",
+        ]
+        if gap["by_harmonic"]:
+            h = gap["by_harmonic"]
+            evidence.append("detection lines: odd misfit {:.2e} (noise {:.2e}), even misfit {:.2e} (noise {:.2e})"
+                            .format(h["odd_detection"]["misfit"], h["odd_detection"]["noise"],
+                                    h["even_detection"]["misfit"], h["even_detection"]["noise"]))
+    return {"verdict": verdict, "chosen_effect": chosen, "significant": significant,
+            "runner_up_close": bool(close), "gap": gap, "ranking": ranking, "evidence": evidence,
+            "nominal": {"params": _free_values(nominal), "calibration_nrmse": nominal.calibration_nrmse,
+                        "evaluations": nominal.evaluations},
+            "calibration_files": [r.name for r in cal], "held_out_files": [r.name for r in held],
+            "data_scale": {"sigma_y": scale.sigma_y, "sigma_v": scale.sigma_v, "k": scale.k},
+            "model": system.name, "fmu": system.fmu}
+
+
+def separation(runner, result, records, fits, bands, upsample) -> dict | None:
+    """When the first two effects score close: where their refitted models differ most, over the measured
+    levels and beyond them (the lowest input x0.3, the highest x2): the level and band to measure next."""
+    if not result["runner_up_close"]:
+        return None
+    a, b = (result["ranking"][i]["effect"] for i in (0, 1))
+    lo = min(records, key=lambda r: r.level_value)
+    hi = max(records, key=lambda r: r.level_value)
+    candidates = [sim.scaled(lo, 0.3)] + list(records) + [sim.scaled(hi, 2.0)]
+    rows = []
+    for rec in candidates:
+        ya, yb = (sim.simulate(runner, rec, fits[e].params, upsample) for e in (a, b))
+        if ya is None or yb is None:
+            continue
+        ref = sim.Record(rec.name, rec.level, rec.level_value, rec.fs, rec.inputs, ya, rec.samples_per_period)
+        band = int(np.argmax(localise.by_band(yb, ref, bands)))
+        rows.append({"level": rec.level, "input_scale_of": rec.name, "difference_nrmse": localise.nrmse(yb, ref),
+                     "band_hz": list(bands[band])})
+    best = max(rows, key=lambda d: d["difference_nrmse"]) if rows else None
+    return {"between": [a, b], "levels": rows, "measure_next": best}
+
+
+def write(result: dict, records, held, sims, bands, out_dir) -> pathlib.Path:
+    """report.json, report.md, gap_map.png (band x level, nominal model) and overlay.png (held-out file)."""
+    import matplotlib.pyplot as plt
+
+    out = pathlib.Path(out_dir)
+    (out / "report.json").write_text(json.dumps(result, indent=1))
+    # gap map: the nominal model's misfit per band (rows) and file (columns)
+    M = np.array([[np.nan] * len(bands) if sims["nominal"][r.name] is None
+                  else localise.by_band(sims["nominal"][r.name], r, bands) for r in records]).T
+    fig, ax = plt.subplots(figsize=(1.6 + 1.1 * len(records), 3.8))
+    im = ax.imshow(M, aspect="auto", origin="lower", cmap="viridis")
+    ax.set_xticks(range(len(records)), [r.level + (" *" if r in held else "") for r in records], fontsize=7,
+                  rotation=20)
+    ax.set_yticks(range(len(bands)), [f"{lo:.1f}-{hi:.1f}" for lo, hi in bands], fontsize=7)
+    ax.set_ylabel("band [Hz]")
+    ax.set_title("nominal model: NRMSE contribution per band and level (* held out)", fontsize=8)
+    fig.colorbar(im, ax=ax)
+    plots._save(fig, out / "gap_map.png")
+    # overlay on the first held-out file: measured, nominal, chosen effect (amplitude spectra)
+    rec = held[0]
+    k = next(iter(rec.outputs))
+    f = np.fft.rfftfreq(rec.n, 1.0 / rec.fs)
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    ax.semilogy(f, np.abs(np.fft.rfft(rec.outputs[k])), "k", lw=0.8, label="measured")
+    for name in ["nominal"] + ([result["chosen_effect"]] if result["chosen_effect"] else []):
+        if sims[name][rec.name] is not None:
+            ax.semilogy(f, np.abs(np.fft.rfft(sims[name][rec.name][k] - rec.outputs[k])), lw=0.7,
+                        label=f"residual, {name}")
+    lo, hi = bands[0][0], bands[-1][1]
+    ax.set_xlim(0.5 * lo, min(rec.fs / 2, 1.5 * hi))
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel(f"|DFT| of {k} [m]")
+    ax.set_title(f"held-out file {rec.name}: output and residual spectra", fontsize=8)
+    ax.legend(fontsize=7)
+    plots._save(fig, out / "overlay.png")
+    md = out / "report.md"
+    md.write_text(markdown(result))
+    return md
+
+
+def markdown(result: dict) -> str:
+    """The report as markdown (tables, evidence, figures)."""
+    g = result["gap"]
+    lines = [f"# Gap diagnosis: {result['model']} ({result['fmu']})", "",
+             f"**Verdict: {result['verdict']}.**", "",
+             f"Calibrated on {', '.join(result['calibration_files'])}; held out: "
+             f"{', '.join(result['held_out_files'])}.", "",
+             f"Held-out gap (NRMSE) of the nominal model: **{g['overall']:.4f}**; noise floor from the data: "
+             f"{g['noise_floor']:.4f}.", "", "## Which effect", "",
+             "| effect | score | held-out gap after | shrink [%] | screening [%] | added params | fitted |",
+             "|---|---|---|---|---|---|---|"]
+    for r in result["ranking"]:
+        params = ", ".join(f"{k} = {v:.4g}" for k, v in r["params"].items())
+        lines.append(f"| {r['effect']} | {r['score']:.1f} | {r['heldout_gap_after']:.4f} | {r['shrink_pct']:.1f} | "
+                     f"{100 * (r['screening_explained'] or 0):.1f} | {r['n_added_params']} | {params} |")
+    if result["ranking"]:
+        lines += ["", "Score = shrink − 5 points per added parameter beyond the first. "
+                  "Shrink = (gap before − gap after) / (gap before − noise floor)."]
+    else:
+        lines += ["", "No effect was refitted: the nominal model fits the held-out files within the noise floor."]
+    if result["evidence"]:
+        lines += ["", "Evidence:", ""] + [f"- {e}" for e in result["evidence"]]
+    sep = result.get("separation")
+    if sep:
+        best = sep["measure_next"]
+        lines += ["", f"**{sep['between'][0]} and {sep['between'][1]} score close.** Their refitted models differ "
+                  f"most at {best['level']} (NRMSE of the difference {best['difference_nrmse']:.3f}), in the band "
+                  f"{best['band_hz'][0]:.1f}-{best['band_hz'][1]:.1f} Hz: measure there to separate them."]
+    lines += ["", "## Where", "", "| band [Hz] | nominal NRMSE contribution (held out) |", "|---|---|"]
+    lines += [f"| {b['band_hz'][0]:.1f}-{b['band_hz'][1]:.1f} | {b['nrmse']:.4f} |" for b in g["by_band"]]
+    lines += ["", "| file | level | held out | nominal NRMSE | noise floor |", "|---|---|---|---|---|"]
+    lines += [f"| {d['file']} | {d['level']} | {'yes' if d['held_out'] else 'no'} | "
+              f"{d['nrmse'] if d['nrmse'] is None else format(d['nrmse'], '.4f')} | {d['noise_floor']:.4f} |"
+              for d in g["by_level"]]
+    if g["by_harmonic"]:
+        lines += ["", "| DFT lines (held out) | misfit | noise |", "|---|---|---|"]
+        lines += [f"| {c} | {v['misfit']:.2e} | {v['noise']:.2e} |" for c, v in g["by_harmonic"].items()]
+    if g["by_loop_region"]:
+        lines += ["", "| loop region (held out) | NRMSE contribution |", "|---|---|"]
+        lines += [f"| {k} | {v:.4f} |" for k, v in g["by_loop_region"].items()]
+    lines += ["", "![gap map](gap_map.png)", "", "![overlay](overlay.png)", ""]
+    return "\n".join(lines)
