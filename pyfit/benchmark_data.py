@@ -34,6 +34,10 @@ def load(name: str, folder: pathlib.Path = DEFAULT_DIR) -> ValidationSignal:
     if name not in ("multisine", "sinesweep"):
         raise ValueError(f"unknown benchmark signal '{name}'; valid: multisine, sinesweep")
     folder = pathlib.Path(folder)
+    for kind in "uy":
+        if not (folder / f"{kind}val_{name}.mat").is_file():
+            raise FileNotFoundError(f"{folder / f'{kind}val_{name}.mat'}: benchmark signal not found (put "
+                                    "../shared/data/boucwen beside the repository or set BOUCWEN_DATA_DIR)")
     u = scipy.io.loadmat(folder / f"uval_{name}.mat")[f"uval_{name}"].ravel().astype(float)
     y = scipy.io.loadmat(folder / f"yval_{name}.mat")[f"yval_{name}"].ravel().astype(float)
     return ValidationSignal(name, u, y, periodic=name == "multisine")

@@ -4,6 +4,7 @@ explains it, and how far the misfit shrinks on held-out files once that effect i
     python scripts/diagnose.py --model sdof --data DATASET_DIR [--config FILE.toml] [--out DIR]
     python scripts/diagnose.py --make-datasets DIR [--seeds 0 1 2]   # the withheld-effect test cases
     python scripts/diagnose.py --benchmark --config configs/diagnose_benchmark.toml   # official Bouc-Wen data
+    python scripts/diagnose.py --cases DIR [--out DIR]   # every dataset under DIR, with summary.md
 """
 import argparse
 import json
@@ -13,7 +14,7 @@ import sys
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from pyfit import benchmark_data  # noqa: E402
-from pyfit.gap import datasets  # noqa: E402
+from pyfit.gap import cases, datasets  # noqa: E402
 from pyfit.gap.diagnose import DiagnoseError, diagnose, load_config  # noqa: E402
 
 
@@ -28,20 +29,25 @@ def main() -> int:
     ap.add_argument("--make-datasets", metavar="DIR", help="write the SDOF withheld-effect datasets into DIR")
     ap.add_argument("--benchmark", action="store_true",
                     help="use the official Bouc-Wen benchmark signals (written as a dataset into OUT/data)")
-    ap.add_argument("--seeds", type=int, nargs="+", default=[0], help="noise seeds of the null cases")
+    ap.add_argument("--cases", metavar="DIR", help="diagnose every dataset folder under DIR and write summary.md")
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2], help="noise seeds of the null cases")
     args = ap.parse_args()
     try:
         if args.make_datasets:
             for path in datasets.write_sdof_cases(args.make_datasets, args.seeds):
                 print(path)
             return 0
+        cfg = load_config(args.config) if args.config else None
+        if args.cases:
+            cases.run_cases(args.cases, args.out, cfg, args.model, args.fmus, args.workers)
+            print((pathlib.Path(args.out) / "summary.md").read_text())
+            return 0
         if args.benchmark:
             args.data = benchmark_data.write_dataset(pathlib.Path(args.out) / "data")
         if not args.data:
             ap.error("--data is required (or --benchmark, --make-datasets)")
-        cfg = load_config(args.config) if args.config else None
         report = diagnose(args.model, args.data, args.out, cfg, args.fmus, args.workers)
-    except DiagnoseError as exc:
+    except (DiagnoseError, FileNotFoundError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     print(json.dumps({k: report[k] for k in ("verdict", "chosen_effect")}, indent=1))

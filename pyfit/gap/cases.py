@@ -1,0 +1,51 @@
+"""Run the diagnosis on every dataset folder under a root (the withheld-effect test cases) and summarise:
+per case the verdict against the withheld effect (read from truth.json only for this summary), the
+shrink, the band of largest misfit and the wall time."""
+from __future__ import annotations
+
+import json
+import pathlib
+import time
+
+from .diagnose import DiagnoseConfig, diagnose
+
+
+def run_cases(root, out_dir, cfg: DiagnoseConfig | None = None, model: str = "sdof", fmu_dir="fmus",
+              workers: int | None = None) -> list[dict]:
+    """Diagnose every sub-folder of root holding a dataset; OUT/<case>/report.*, OUT/summary.md."""
+    rows = []
+    for case in sorted(p for p in pathlib.Path(root).iterdir() if p.is_dir() and any(p.glob("*.csv"))):
+        t0 = time.perf_counter()
+        rep = diagnose(model, case, pathlib.Path(out_dir) / case.name, cfg, fmu_dir, workers, progress=False)
+        truth = json.loads((case / "truth.json").read_text())["effect"] if (case / "truth.json").is_file() else None
+        expected = None if truth in (None, "none") else truth
+        top = rep["ranking"][0] if rep["ranking"] else None
+        rows.append({"case": case.name, "withheld": truth, "verdict": rep["verdict"],
+                     "correct": rep["chosen_effect"] == expected, "gap": rep["gap"]["overall"],
+                     "noise_floor": rep["gap"]["noise_floor"], "worst_band_hz": rep["gap"]["worst_band_hz"],
+                     "shrink_pct": top["shrink_pct"] if top and rep["chosen_effect"] else None,
+                     "runner_up": rep["ranking"][1]["effect"] if len(rep["ranking"]) > 1 else None,
+                     "runner_up_shrink_pct": rep["ranking"][1]["shrink_pct"] if len(rep["ranking"]) > 1 else None,
+                     "wall_s": time.perf_counter() - t0})
+    write_summary(rows, out_dir)
+    return rows
+
+
+def write_summary(rows: list[dict], out_dir) -> pathlib.Path:
+    """summary.md and summary.json of run_cases."""
+    out = pathlib.Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "summary.json").write_text(json.dumps(rows, indent=1))
+    lines = ["| case | withheld | verdict | correct | held-out gap | noise floor | largest misfit [Hz] | shrink [%] "
+             "| runner-up (shrink %) | wall [s] |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        ru = f"{r['runner_up']} ({r['runner_up_shrink_pct']:.1f})" if r["runner_up"] else "—"
+        sh = f"{r['shrink_pct']:.1f}" if r["shrink_pct"] is not None else "—"
+        lines.append(f"| {r['case']} | {r['withheld']} | {r['verdict']} | {'yes' if r['correct'] else 'NO'} | "
+                     f"{r['gap']:.4f} | {r['noise_floor']:.4f} | {r['worst_band_hz'][0]:.1f}–{r['worst_band_hz'][1]:.1f}"
+                     f" | {sh} | {ru} | {r['wall_s']:.0f} |")
+    n_ok = sum(r["correct"] for r in rows)
+    lines += ["", f"{n_ok} of {len(rows)} cases correct."]
+    md = out / "summary.md"
+    md.write_text("\n".join(lines) + "\n")
+    return md
