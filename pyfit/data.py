@@ -119,6 +119,15 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
                        None if lv is None else float(lv), dict(meta.get("excitation", {})), str(meta.get("notes", "")))
 
 
+def _toml_value(v) -> str:
+    """A scalar as TOML: quoted string, true/false, or number."""
+    if isinstance(v, str):
+        return f'"{v}"'
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    return f"{v}"
+
+
 def write_measurement(csv_path: str | pathlib.Path, model: str, t: np.ndarray, inputs: dict[str, tuple],
                       outputs: dict[str, tuple], level: str = "", level_value: float | None = None,
                       excitation: dict | None = None, notes: str = "") -> pathlib.Path:
@@ -150,7 +159,7 @@ def write_measurement(csv_path: str | pathlib.Path, model: str, t: np.ndarray, i
     if excitation:
         lines.append("[excitation]")
         for k, v in excitation.items():
-            lines.append(f'{k} = "{v}"' if isinstance(v, str) else f"{k} = {v}")
+            lines.append(f"{k} = {_toml_value(v)}")
     csv_path.with_suffix(".toml").write_text("\n".join(lines) + "\n")
     return csv_path
 

@@ -133,6 +133,13 @@ class PeriodicSignal:
         self.omegas = 2 * np.pi * lines * fs / n
         self.phases = np.angle(spec[lines])
 
+    def derivative(self, t: np.ndarray, order: int) -> np.ndarray:
+        """The order-th time derivative at times t [s] (numpy), exact."""
+        t = np.asarray(t, float)
+        w = self.omegas[:, None]
+        return np.sum(self.amplitudes[:, None] * w**order * np.cos(w * t.ravel() + self.phases[:, None]
+                                                                  + order * np.pi / 2), axis=0).reshape(t.shape)
+
     def __call__(self, t):
         if isinstance(t, (ca.SX, ca.MX)):
             out = self.mean

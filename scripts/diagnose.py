@@ -1,7 +1,7 @@
 """Sim-to-real gap diagnosis: where the nominal model misfits a measured dataset, which candidate effect
 explains it, and how far the misfit shrinks on held-out files once that effect is added.
 
-    python scripts/diagnose.py --model sdof --data DATASET_DIR [--config FILE.toml] [--out DIR]
+    python scripts/diagnose.py --model sdof|damper --data DATASET_DIR [--config FILE.toml] [--out DIR]
     python scripts/diagnose.py --make-datasets DIR [--seeds 0 1 2]   # the withheld-effect test cases
     python scripts/diagnose.py --benchmark --config configs/diagnose_benchmark.toml   # official Bouc-Wen data
     python scripts/diagnose.py --cases DIR [--out DIR]   # every dataset under DIR, with summary.md
@@ -20,13 +20,13 @@ from pyfit.gap.diagnose import DiagnoseError, diagnose, load_config  # noqa: E40
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--model", default="sdof", help="nominal model: sdof")
+    ap.add_argument("--model", default="sdof", help="nominal model: sdof (linear SDOF) or damper (linear FE damper)")
     ap.add_argument("--data", help="dataset folder (CSV + TOML pairs, design section 5)")
     ap.add_argument("--config", help="TOML with a [diagnose] table")
     ap.add_argument("--out", default="results/diagnose")
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument("--fmus", default="fmus")
-    ap.add_argument("--make-datasets", metavar="DIR", help="write the SDOF withheld-effect datasets into DIR")
+    ap.add_argument("--make-datasets", metavar="DIR", help="write the withheld-effect datasets of --model into DIR")
     ap.add_argument("--benchmark", action="store_true",
                     help="use the official Bouc-Wen benchmark signals (written as a dataset into OUT/data)")
     ap.add_argument("--cases", metavar="DIR", help="diagnose every dataset folder under DIR and write summary.md")
@@ -34,7 +34,7 @@ def main() -> int:
     args = ap.parse_args()
     try:
         if args.make_datasets:
-            for path in datasets.write_sdof_cases(args.make_datasets, args.seeds):
+            for path in datasets.write_cases(args.make_datasets, args.model, args.seeds):
                 print(path)
             return 0
         cfg = load_config(args.config) if args.config else None

@@ -12,7 +12,7 @@ import numpy as np
 from ..fmu import FmuRunner
 from ..optim.baselines import polish
 from . import simulate as sim
-from .systems import LINEAR_PARAMS, Effect, Scale, System
+from .systems import Effect, Scale, System
 
 
 @dataclass
@@ -31,30 +31,6 @@ class Fit:
         return asdict(self)
 
 
-def frf_linear_guess(records: list[sim.Record]) -> dict:
-    """m, c, k of a linear SDOF from the measured FRF (input -> output DFT lines the input excites):
-    1/H = k - w^2 m + i w c, solved by least squares weighted by |H| (relative error)."""
-    rows, rhs = [], []
-    for rec in records:
-        u, y = next(iter(rec.inputs.values())), next(iter(rec.outputs.values()))
-        U, Y = np.fft.rfft(u), np.fft.rfft(y)
-        w = 2 * np.pi * np.fft.rfftfreq(len(u), 1.0 / rec.fs)
-        ex = (np.abs(U) > 1e-3 * np.abs(U).max()) & (w > 0)
-        G = U[ex] / Y[ex]  # 1/H
-        wt = 1.0 / np.abs(G)
-        rows += [np.column_stack([-w[ex] ** 2 * wt, 0 * wt, wt]), np.column_stack([0 * wt, w[ex] * wt, 0 * wt])]
-        rhs += [G.real * wt, G.imag * wt]
-    m, c, k = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
-    return {"m": float(abs(m)), "c": float(abs(c)), "k": float(abs(k))}
-
-
-def data_scale(records: list[sim.Record], k: float) -> Scale:
-    """RMS of the measured output and of its velocity over the records, and the stiffness k."""
-    y = np.concatenate([next(iter(r.outputs.values())) for r in records])
-    v = np.concatenate([np.gradient(next(iter(r.outputs.values()))) * r.fs for r in records])
-    return Scale(float(np.sqrt(np.mean(y**2))), float(np.sqrt(np.mean(v**2))), k)
-
-
 @dataclass(frozen=True)
 class FitTask:
     """Everything one fit needs, picklable for a process pool (SI units)."""
@@ -68,10 +44,12 @@ class FitTask:
     n_added: int
     budget: int
     upsample: int
+    lead_periods: int = 1
 
 
 def _stacked(runner, task: FitTask, params: dict) -> np.ndarray:
-    return np.concatenate([sim.residuals(sim.simulate(runner, r, params, task.upsample), r) for r in task.records])
+    return np.concatenate([sim.residuals(sim.simulate(runner, r, params, task.upsample, task.lead_periods), r)
+                           for r in task.records])
 
 
 def run_fit(task: FitTask) -> Fit:
@@ -94,23 +72,18 @@ def run_fit(task: FitTask) -> Fit:
                result.n_evaluations + 1, time.perf_counter() - t0)
 
 
-def linear_bounds(guess: dict, hysteresis: bool = False) -> dict:
-    """Bounds of m, c, k around a linear estimate (k lower when a hysteretic element shares the stiffness)."""
-    return {"m": (0.5 * guess["m"], 2.0 * guess["m"]), "c": (0.1 * guess["c"], 5.0 * guess["c"]),
-            "k": ((0.05 if hysteresis else 0.5) * guess["k"], 2.0 * guess["k"])}
+def nominal_task(system: System, fmu: str, records: list, budget: int, upsample: int) -> FitTask:
+    """The nominal (linear) calibration from the system's start (the SDOF: its measured FRF)."""
+    start = system.start(records)
+    return FitTask(fmu, tuple(records), dict(system.nominal_fixed), {n: start[n] for n in system.linear},
+                   system.bounds(start), "nominal", 0, budget, upsample, system.lead_periods)
 
 
-def nominal_task(system: System, fmu: str, records: list, guess: dict, budget: int, upsample: int) -> FitTask:
-    """The nominal (linear) calibration from the FRF estimate."""
-    return FitTask(fmu, tuple(records), dict(system.nominal_fixed), {n: guess[n] for n in LINEAR_PARAMS},
-                   linear_bounds(guess), "nominal", 0, budget, upsample)
-
-
-def effect_start(effect: Effect, scale: Scale, nominal: dict) -> tuple[dict, dict, dict]:
+def effect_start(system: System, effect: Effect, scale: Scale, nominal: dict) -> tuple[dict, dict, dict]:
     """Start values, bounds and fixed parameters of the nominal model with `effect` added."""
-    start = {n: nominal[n] for n in LINEAR_PARAMS}
-    start["k"] = nominal["k"] * (1.0 - effect.shift_stiffness)
-    bounds = linear_bounds(nominal, hysteresis=effect.shift_stiffness > 0)
+    start = {n: nominal[n] for n in system.linear}
+    start[system.stiffness] = nominal[system.stiffness] * (1.0 - effect.shift_stiffness)
+    bounds = system.bounds(nominal, softened=effect.shift_stiffness > 0)
     for p in effect.params:
         lo, st, hi = p.range(scale)
         start[p.name], bounds[p.name] = st, (lo, hi)
@@ -120,14 +93,14 @@ def effect_start(effect: Effect, scale: Scale, nominal: dict) -> tuple[dict, dic
 def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal: Fit, scale: Scale,
                 budget: int, upsample: int) -> FitTask:
     """The refit of the nominal model with `effect` added."""
-    start, bounds, fixed = effect_start(effect, scale, nominal.params)
+    start, bounds, fixed = effect_start(system, effect, scale, nominal.params)
     return FitTask(fmu, tuple(records), {**system.nominal_fixed, **fixed}, start, bounds, effect.name,
-                   len(effect.params), budget, upsample)
+                   len(effect.params), budget, upsample, system.lead_periods)
 
 
 def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int,
            probe: float = 0.05) -> dict[str, float]:
-    """Fraction of the nominal residual (after re-adjusting m, c, k) that one Gauss-Newton step along each
+    """Fraction of the nominal residual (after re-adjusting the linear parameters) that one Gauss-Newton step along each
     effect's sensitivity direction removes: 1 - |r - P_[J_lin, d] r|^2 / |r - P_J_lin r|^2. The direction
     is the output change from the nominal to the effect at a small probe strength (probe x its range; a
     hysteretic element at its start, where it is more than a stiffness)."""
@@ -135,11 +108,12 @@ def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, 
     base = dict(nominal.params)
 
     def stacked(p):
-        return np.concatenate([sim.residuals(sim.simulate(runner, r, p, upsample), r) for r in records])
+        return np.concatenate([sim.residuals(sim.simulate(runner, r, p, upsample, system.lead_periods), r)
+                               for r in records])
 
     r0 = stacked(base)
     J = []
-    for n in LINEAR_PARAMS:
+    for n in system.linear:
         h = 1e-3 * base[n]
         J.append((stacked({**base, n: base[n] + h}) - r0) / h * base[n])
     J = np.column_stack(J)
@@ -151,8 +125,8 @@ def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, 
     lin = unexplained(J)
     out = {}
     for name, effect in system.effects.items():
-        start, _, fixed = effect_start(effect, scale, base)
-        p = {**base, **fixed, "k": start["k"]}
+        start, _, fixed = effect_start(system, effect, scale, base)
+        p = {**base, **fixed, system.stiffness: start[system.stiffness]}
         for prm in effect.params:
             lo, st, hi = prm.range(scale)
             p[prm.name] = st if st != 0 else probe * (hi if hi > 0 else lo)

@@ -17,7 +17,7 @@ from ..run_example import ensure_fmu
 from ..tomlfile import read_toml
 from . import localise
 from . import simulate as sim
-from .attribute import Fit, data_scale, effect_task, frf_linear_guess, nominal_task, run_fit, screen
+from .attribute import Fit, effect_task, nominal_task, run_fit, screen
 from .systems import get_system
 
 
@@ -130,7 +130,7 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
 
 def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, fmu_dir="fmus",
              workers: int | None = None, progress: bool = True) -> dict:
-    """Diagnose the dataset against the nominal model `model` ('sdof'); writes OUT/report.json,
+    """Diagnose the dataset against the nominal model `model` ('sdof' or 'damper'); writes OUT/report.json,
     OUT/report.md and figures; returns the report. When the nominal model already fits the held-out files
     within the noise floor, no effect is refitted (verdict 'no significant gap')."""
     from . import report
@@ -148,11 +148,11 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
 
     nominal = _stored(out / "fits" / "nominal.json", key)
     if nominal is None:
-        task = nominal_task(system, fmu, cal, frf_linear_guess(cal), cfg.nominal_budget, cfg.upsample)
+        task = nominal_task(system, fmu, cal, cfg.nominal_budget, cfg.upsample)
         nominal = _fit_and_store((task, out / "fits" / "nominal.json", key))
-    scale = data_scale(cal, nominal.params["k"])
+    scale = system.scale(cal, nominal.params)
     runner = FmuRunner(fmu)
-    sims = {"nominal": {r.name: sim.simulate(runner, r, nominal.params, cfg.upsample) for r in records}}
+    sims = {"nominal": {r.name: sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods) for r in records}}
     bands = [tuple(b) for b in cfg.bands_hz] if cfg.bands_hz else localise.default_bands(records)
     gap = report.nominal_gap(sims["nominal"], records, held, bands, cfg)
     screening, fits = {}, {}
@@ -174,9 +174,10 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="refits"):
             fits[fit.effect] = fit
         for name, f in fits.items():
-            sims[name] = {r.name: sim.simulate(runner, r, f.params, cfg.upsample) for r in records}
+            sims[name] = {r.name: sim.simulate(runner, r, f.params, cfg.upsample, system.lead_periods)
+                          for r in records}
     result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap)
-    result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample)
+    result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample, system.lead_periods)
     runner.close()
     report.write(result, records, held, sims, bands, out)
     return result

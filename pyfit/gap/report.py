@@ -44,7 +44,7 @@ def _gap(sims: dict, records, held, bands) -> dict:
 
 def _free_values(fit) -> dict:
     out = {n: fit.params[n] for n in fit.free}
-    if fit.effect == "hysteresis":
+    if fit.effect == "hysteresis" and "gamma" in fit.free:
         out["beta (fixed)"] = fit.params["beta"]
         out["beta*gamma"] = fit.params["beta"] * fit.params["gamma"]
         out["beta*delta"] = fit.params["beta"] * fit.params["delta"]
@@ -112,7 +112,7 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
             "model": system.name, "fmu": system.fmu}
 
 
-def separation(runner, result, records, fits, bands, upsample) -> dict | None:
+def separation(runner, result, records, fits, bands, upsample, lead_periods=1) -> dict | None:
     """When the first two effects score close: where their refitted models differ most, over the measured
     levels and beyond them (the lowest input x0.3, the highest x2): the level and band to measure next."""
     if not result["runner_up_close"]:
@@ -123,7 +123,7 @@ def separation(runner, result, records, fits, bands, upsample) -> dict | None:
     candidates = [sim.scaled(lo, 0.3)] + list(records) + [sim.scaled(hi, 2.0)]
     rows = []
     for rec in candidates:
-        ya, yb = (sim.simulate(runner, rec, fits[e].params, upsample) for e in (a, b))
+        ya, yb = (sim.simulate(runner, rec, fits[e].params, upsample, lead_periods) for e in (a, b))
         if ya is None or yb is None:
             continue
         ref = sim.Record(rec.name, rec.level, rec.level_value, rec.fs, rec.inputs, ya, rec.samples_per_period)

@@ -1,6 +1,6 @@
 """Run the FMU on measured files: the input as measured (band-limited upsampling for periodic records,
 a cubic spline otherwise), outputs on the file's time grid. A periodic record is taken as steady state:
-one extra period is simulated in front of it and dropped. A failed or diverging run returns None."""
+periods are simulated in front of it and dropped. A failed or diverging run returns None."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -51,16 +51,19 @@ def scaled(rec: Record, factor: float) -> Record:
                   {k: v * factor for k, v in rec.inputs.items()}, rec.outputs, rec.samples_per_period)
 
 
-def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, tolerance: float = 1e-8
-             ) -> dict | None:
-    """Outputs (model variable -> samples on the record's grid) for FMU parameters params; None on failure."""
+def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, lead_periods: int = 1,
+             tolerance: float = 1e-8) -> dict | None:
+    """Outputs (model variable -> samples on the record's grid) for FMU parameters params; None on failure.
+    A periodic record is preceded by lead_periods simulated periods (dropped)."""
     q = upsample
     if rec.periodic:
         spp = rec.samples_per_period
         periods = rec.n // spp
-        fine = {k: np.concatenate([np.tile(upsample_periodic(v[:spp], q), periods + 1), upsample_periodic(v[:spp], q)[:1]])
-                for k, v in rec.inputs.items()}
-        skip = spp * q
+        fine = {}
+        for k, v in rec.inputs.items():
+            one = upsample_periodic(v[:spp], q)
+            fine[k] = np.concatenate([np.tile(one, periods + lead_periods), one[:1]])
+        skip = lead_periods * spp * q
     else:
         fine = {k: upsample_spline(v, q) for k, v in rec.inputs.items()}
         skip = 0
