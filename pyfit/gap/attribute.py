@@ -47,9 +47,10 @@ class FitTask:
     lead_periods: int = 1
 
 
-def _stacked(runner, task: FitTask, params: dict) -> np.ndarray:
-    return np.concatenate([sim.residuals(sim.simulate(runner, r, params, task.upsample, task.lead_periods), r)
-                           for r in task.records])
+def _stacked(runner, records, params: dict, upsample: int, lead_periods: int) -> np.ndarray:
+    """The calibration records' residuals, stacked."""
+    return np.concatenate([sim.residuals(sim.simulate(runner, r, params, upsample, lead_periods), r)
+                           for r in records])
 
 
 def run_fit(task: FitTask) -> Fit:
@@ -64,9 +65,12 @@ def run_fit(task: FitTask) -> Fit:
         return {**task.fixed, **dict(zip(names, lo + np.clip(x, 0, 1) * (hi - lo)))}
 
     x0 = (np.array([task.start[n] for n in names]) - lo) / (hi - lo)
-    result = polish(lambda x: _stacked(runner, task, params(x)), x0, budget=task.budget)
+    def residuals(p):
+        return _stacked(runner, task.records, p, task.upsample, task.lead_periods)
+
+    result = polish(lambda x: residuals(params(x)), x0, budget=task.budget)
     best = params(result.x)
-    err = float(np.sqrt(np.sum(_stacked(runner, task, best) ** 2) / len(task.records)))
+    err = float(np.sqrt(np.sum(residuals(best) ** 2) / len(task.records)))
     runner.close()
     return Fit(task.effect, {k: float(v) for k, v in best.items()}, names, task.n_added, err,
                result.n_evaluations + 1, time.perf_counter() - t0)
@@ -98,18 +102,17 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
                    len(effect.params), budget, upsample, system.lead_periods)
 
 
-def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int,
+def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int, effects: list,
            probe: float = 0.05) -> dict[str, float]:
-    """Fraction of the nominal residual (after re-adjusting the linear parameters) that one Gauss-Newton step along each
-    effect's sensitivity direction removes: 1 - |r - P_[J_lin, d] r|^2 / |r - P_J_lin r|^2. The direction
+    """For each of `effects`: the fraction of the nominal residual (after re-adjusting the linear
+    parameters) that one Gauss-Newton step along the effect's sensitivity direction removes: 1 - |r - P_[J_lin, d] r|^2 / |r - P_J_lin r|^2. The direction
     is the output change from the nominal to the effect at a small probe strength (probe x its range; a
     hysteretic element at its start, where it is more than a stiffness)."""
     runner = FmuRunner(fmu)
     base = dict(nominal.params)
 
     def stacked(p):
-        return np.concatenate([sim.residuals(sim.simulate(runner, r, p, upsample, system.lead_periods), r)
-                               for r in records])
+        return _stacked(runner, records, p, upsample, system.lead_periods)
 
     r0 = stacked(base)
     J = []
@@ -124,7 +127,8 @@ def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, 
 
     lin = unexplained(J)
     out = {}
-    for name, effect in system.effects.items():
+    for name in effects:
+        effect = system.effects[name]
         start, _, fixed = effect_start(system, effect, scale, base)
         p = {**base, **fixed, system.stiffness: start[system.stiffness]}
         for prm in effect.params:

@@ -156,16 +156,17 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     bands = [tuple(b) for b in cfg.bands_hz] if cfg.bands_hz else localise.default_bands(records)
     gap = report.nominal_gap(sims["nominal"], records, held, bands, cfg)
     screening, fits = {}, {}
+    effects = cfg.effects or list(system.effects)
     if gap["significant"]:  # otherwise the nominal model explains the data within its noise: nothing to attribute
         screening_path = out / "fits" / "screening.json"
         stored = json.loads(screening_path.read_text()) if screening_path.is_file() else {}
         if stored.get("key") == key:
             screening = stored["fractions"]
         else:
-            screening = screen(system, fmu, cal, nominal, scale, cfg.upsample)
+            screening = screen(system, fmu, cal, nominal, scale, cfg.upsample, effects)
             screening_path.write_text(json.dumps({"key": key, "fractions": screening}, indent=1))
         jobs = []
-        for name in cfg.effects or list(system.effects):
+        for name in effects:
             path = out / "fits" / f"{name}.json"
             fits[name] = _stored(path, key)
             if fits[name] is None:
