@@ -95,3 +95,20 @@ def test_bad_input_gives_one_clear_error(data_root, tmp_path, fmu_dir):
     cfg.write_text("[diagnose]\nrefit_budget = 'many'\n")
     with pytest.raises(dg.DiagnoseError, match=r"refit_budget = 'many': expected int"):
         dg.load_config(cfg)
+
+
+def test_close_runner_up_gets_a_level_and_band_to_measure(data_root, fmu_dir):
+    # reuse the stored refits of the quadratic-damping case; call every runner-up close (close_points 100)
+    out = data_root / "out_quadratic_damping"
+    if not (out / "report.json").is_file():
+        pytest.skip("needs the quadratic_damping case above")
+    cfg = dg.DiagnoseConfig(nominal_budget=30, refit_budget=60, close_points=100.0)
+    rep = dg.diagnose("sdof", _case(data_root, "quadratic_damping"), out, cfg, fmu_dir, workers=1, progress=False)
+    sep = rep["separation"]
+    assert rep["runner_up_close"] and sep["between"] == [r["effect"] for r in rep["ranking"][:2]]
+    # the candidates were simulated at the three measured levels and beyond them (x0.3, x2)
+    assert len(sep["levels"]) == 5
+    best = sep["measure_next"]
+    assert best["difference_nrmse"] == max(d["difference_nrmse"] for d in sep["levels"]) > 0
+    assert best["band_hz"][0] < best["band_hz"][1]
+    assert "score close" in (out / "report.md").read_text()
