@@ -8,7 +8,6 @@ import json
 import pathlib
 from dataclasses import asdict, dataclass, fields
 
-import numpy as np
 
 from ..batch import map_tasks
 from ..data import MeasurementError, read_dataset
