@@ -126,12 +126,19 @@ def _state_map(probe: _MEProbe, phys: list[str], t, inputs):
     return A, b
 
 
+# sampling scale of the candidate-effect parameters (design 6) in the right-hand-side check (SI units)
+_EFFECT_SAMPLES = {"k3": 1e9, "F_c": 2.0, "c2": 10.0, "F_c1": 0.5, "F_c2": 0.5, "c2_1": 5.0, "c2_2": 5.0}
+
+
 def _samples(name, ref, n, seed):
     rng = np.random.default_rng(seed)
     scale = np.array(_SCALE[_family(name)])
     for _ in range(n):
         x = scale * rng.uniform(0.2, 1.0, scale.size) * rng.choice([-1, 1], scale.size)
         p = ref.param_vector() * rng.uniform(0.8, 1.2, len(ref.param_names))
+        for i, n in enumerate(ref.param_names):  # candidate effects are off (0) by default: switch them on
+            if n in _EFFECT_SAMPLES and p[i] == 0:
+                p[i] = _EFFECT_SAMPLES[n] * rng.uniform(0.2, 1.0)
         u = rng.normal(size=ref.u.numel()) * (10.0 if ref.u.numel() == 1 else np.array([1e-3, 0.05, 5.0]))
         yield x, p, u, rng.uniform(0, 10)
 
