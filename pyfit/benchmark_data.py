@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.io
 
-from .signals import rms_db, upsample_periodic, upsample_spline  # noqa: F401  (rms_db: the figure of merit)
+from .signals import periodic_drive, rms_db, upsample_spline  # noqa: F401  (rms_db: the figure of merit)
 
 FS_HZ = 750.0  # sampling frequency of the official signals (not stored in the files)
 # ../shared/data/boucwen beside the repository, or the folder named by BOUCWEN_DATA_DIR
@@ -52,8 +52,7 @@ def simulate_validation(runner, signal: ValidationSignal, upsample: int = 20, pe
     """
     fs = FS_HZ * upsample
     if signal.periodic:
-        one = upsample_periodic(signal.u, upsample)
-        u = np.concatenate([np.tile(one, periods), one[:1]])
+        u = periodic_drive(signal.u, upsample, periods)
     else:
         u = upsample_spline(signal.u, upsample)
     t = np.arange(len(u)) / fs

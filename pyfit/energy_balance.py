@@ -31,6 +31,7 @@ from scipy.optimize import brentq
 
 from . import plots
 from .batch import RunSpec, run_batch
+from .span import span_properties
 
 CIGRE_FNC = (-99.73, 101.62, 0.1627, 0.2256)  # W/(m·Hz³·m⁴), polynomial in Y/D, highest power first
 ETA_MAX = 1.2  # Y/D searched up to here (the CIGRE fnc turns negative above Y/D = 1.02)
@@ -56,9 +57,9 @@ class Conductor:
 
 def conductor_of_span(span_fmu, diameter: float = DRAKE_DIAMETER, **overrides) -> Conductor:
     """The Conductor of a ConductorSpan FMU (its start values of L, T, m_l, zeta), fields overridable."""
-    v = span_fmu.variables
-    start = {"mass_per_length": "m_l", "tension": "T", "span_length": "L", "zeta": "zeta"}
-    return Conductor(diameter, **{k: float(overrides.get(k, v[n].start)) for k, n in start.items()})
+    p = span_properties(span_fmu)
+    return Conductor(diameter, overrides.get("mass_per_length", p["m_l"]), overrides.get("tension", p["T"]),
+                     overrides.get("span_length", p["L"]), overrides.get("zeta", p["zeta"]))
 
 
 def wind_power(f, Y, conductor: Conductor, turbulence: float = 0.0):

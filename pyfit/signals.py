@@ -188,6 +188,13 @@ def upsample_periodic(u: np.ndarray, factor: int) -> np.ndarray:
     return np.fft.irfft(padded, n * factor) * factor
 
 
+def periodic_drive(period: np.ndarray, factor: int, periods: int) -> np.ndarray:
+    """`periods` repetitions of one period upsampled by `factor` (band-limited), plus the closing sample:
+    an input for a simulation from rest that reaches the periodic steady state."""
+    one = upsample_periodic(period, factor)
+    return np.concatenate([np.tile(one, periods), one[:1]])
+
+
 def upsample_spline(u: np.ndarray, factor: int) -> np.ndarray:
     """Cubic-spline upsampling of a non-periodic signal that starts from rest."""
     t = np.arange(len(u))

@@ -49,13 +49,19 @@ class ModeDecay:
         return (self.energy_loss - self.self_damping - self.damper) / self.damper
 
 
+def span_properties(span_fmu: FmuRunner, overrides: dict | None = None) -> dict:
+    """Length L [m], tension T [N], mass per length m_l [kg/m], self-damping zeta of a ConductorSpan FMU:
+    its start values unless overridden."""
+    return {k: float((overrides or {}).get(k, span_fmu.variables[k].start)) for k in ("L", "T", "m_l", "zeta")}
+
+
 def mode_decay(span_fmu, damper_fmu, mode: int, x_d: float, amplitude: float = 5e-3, periods: float = 10.0,
                step: float = 1e-4, span_params: dict | None = None, damper_params: dict | None = None) -> ModeDecay:
     """Free decay of `mode` (antinode amplitude [m]) over `periods` of its frequency, damper at x_d [m]."""
     sp = {"exc_type": 0, "x_d": x_d, f"q[{mode}]": amplitude, **(span_params or {})}
     dp = {"m_c": 0.0, **(damper_params or {})}
     span_fmu = span_fmu if isinstance(span_fmu, FmuRunner) else FmuRunner(str(span_fmu))
-    L, T, m_l, zeta = (float(sp.get(k, span_fmu.variables[k].start)) for k in ("L", "T", "m_l", "zeta"))
+    L, T, m_l, zeta = (span_properties(span_fmu, sp)[k] for k in ("L", "T", "m_l", "zeta"))
     f = mode * np.sqrt(T / m_l) / (2 * L)
     stop = step * max(1, int(round(periods / f / step)))
     r = cosimulate({"span": span_fmu, "damper": damper_fmu}, CONNECTIONS, stop, step,

@@ -22,7 +22,7 @@ def data_root(tmp_path_factory):
 def _case(root, effect, seed=0):
     path = root / f"{effect}_seed{seed}"
     if not path.is_dir():
-        datasets.write_sdof_dataset(path, effect, seed=seed, periods=2)
+        datasets.write_dataset(path, datasets.SDOF, effect, seed=seed, periods=2)
     return path
 
 

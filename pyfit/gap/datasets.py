@@ -114,11 +114,6 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     return out
 
 
-def write_sdof_dataset(out_dir, effect: str, seed: int = 0, periods: int = PERIODS) -> pathlib.Path:
-    """write_dataset for the SDOF family."""
-    return write_dataset(out_dir, SDOF, effect, seed, periods)
-
-
 def write_cases(out_dir, family: str = "sdof", null_seeds=(0, 1, 2), periods: int = PERIODS) -> list[pathlib.Path]:
     """The test cases of a family: each effect withheld (seed 0) and the null case for every noise seed."""
     fam, out = FAMILIES[family], pathlib.Path(out_dir)

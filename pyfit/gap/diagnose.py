@@ -173,9 +173,9 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
                                          cfg.upsample), str(path), key))
         for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="refits"):
             fits[fit.effect] = fit
-        for name, f in fits.items():
+        for name, f in fits.items():  # an effect is judged on the held-out files only
             sims[name] = {r.name: sim.simulate(runner, r, f.params, cfg.upsample, system.lead_periods)
-                          for r in records}
+                          for r in held}
     result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap)
     result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample, system.lead_periods)
     runner.close()

@@ -68,7 +68,8 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
     floor, before, significant = gap["noise_floor"], gap["overall"], gap["significant"]
     ranking = []
     for name, fit in fits.items():
-        after = _gap(sims[name], records, held, bands)["overall"]
+        done = [localise.nrmse(sims[name][r.name], r) for r in held if sims[name][r.name] is not None]
+        after = _rms_over(done) if len(done) == len(held) else float("inf")
         shrink = 100.0 * (before - after) / (before - floor) if before > floor else 0.0
         ranking.append({"effect": name, "score": shrink - 5.0 * (fit.n_added - 1), "heldout_gap_before": before,
                         "heldout_gap_after": after, "shrink_pct": shrink, "params": _free_values(fit),

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..data import Measurement
 from ..fmu import FmuRunner
-from ..signals import upsample_periodic, upsample_spline
+from ..signals import periodic_drive, upsample_spline
 
 
 @dataclass
@@ -59,10 +59,7 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
     if rec.periodic:
         spp = rec.samples_per_period
         periods = rec.n // spp
-        fine = {}
-        for k, v in rec.inputs.items():
-            one = upsample_periodic(v[:spp], q)
-            fine[k] = np.concatenate([np.tile(one, periods + lead_periods), one[:1]])
+        fine = {k: periodic_drive(v[:spp], q, periods + lead_periods) for k, v in rec.inputs.items()}
         skip = lead_periods * spp * q
     else:
         fine = {k: upsample_spline(v, q) for k, v in rec.inputs.items()}
