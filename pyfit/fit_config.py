@@ -44,6 +44,7 @@ class FitConfig:
     truth: dict[str, float] = field(default_factory=dict)
     products: list[tuple[str, str]] = field(default_factory=list)
     benchmark: bool = False  # report the RMS error on the official Bouc-Wen validation signals
+    nno_log_ratio: bool = False  # the NNO surrogate learns log(P/P_meas) of a psd_band objective
 
     def problem_key(self) -> str:
         """Identifies the optimisation problem (target, objective, free and fixed parameters), so that
@@ -89,7 +90,11 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
             "excitation": (dict, False, None), "multisine": (dict, False, None), "stop_time": (float, False, 0.0),
             "sample_rate_hz": (float, True, None), "outputs": ("strings", True, None), "noise_std": (dict, False, {}),
             "parameters": (dict, False, {}), "oversample": (int, False, 10), "seed": (int, False, 1),
-            "solver": (str, False, "cvodes"), "anti_alias": (bool, False, True)})
+            "solver": (str, False, "cvodes"), "anti_alias": (bool, False, True),
+            "passband_ripple_db": (float, False, None)})
+        if sy["passband_ripple_db"] is not None and not (sy["anti_alias"] and 0 < sy["passband_ripple_db"] < 1):
+            fail(path, "target.synthetic.passband_ripple_db", f"{sy['passband_ripple_db']} needs anti_alias = true",
+                 "a ripple in dB between 0 and 1, e.g. 0.005")
         if (sy["excitation"] is None) == (sy["multisine"] is None):
             fail(path, "target.synthetic", "needs exactly one of excitation and multisine")
         if sy["solver"] not in ("cvodes", "newmark"):
@@ -147,7 +152,10 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
     nn = check_table(doc.get("nno", {}), path, "nno", {
         "init_sim": (int, False, 20), "hidden_sizes": (list, False, [15]), "p_size": (int, False, 20),
         "fun_tol": (float, False, 0.0), "x_tol": (float, False, 1e-3), "y_tol": (float, False, 1e-3),
-        "ga_generations": (int, False, 50)})
+        "ga_generations": (int, False, 50), "trust_region": (bool, False, False),
+        "log_ratio": (bool, False, False)})
+    if nn["log_ratio"] and ob["kind"] != "psd_band":
+        fail(path, "nno.log_ratio", "learns log(P/P_meas) of the relative PSD error", 'objective.kind = "psd_band"')
     raw_polish = dict(doc.get("polish", {}))
     if isinstance(raw_polish.get("budget"), int):
         raw_polish["budget"] = [raw_polish["budget"]]
@@ -167,9 +175,10 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
         fail(path, "nno.init_sim", f"init_sim = {nn['init_sim']} leaves no NNO iteration within the budget "
                                     f"({nno_budget} true evaluations for NNO)")
     settings = NNOSettings(nn["init_sim"], [int(h) for h in nn["hidden_sizes"]], nn["p_size"], nn["fun_tol"],
-                           nno_budget, nn["x_tol"], nn["y_tol"], nn["ga_generations"], fit["seed"])
+                           nno_budget, nn["x_tol"], nn["y_tol"], nn["ga_generations"], fit["seed"],
+                           nn["trust_region"])
     return FitConfig(path, fit["model"], fit["method"], fit["budget"], fit["seed"], target_file, synthetic, fixed,
                      ob["kind"], channels, ob["segment_s"], ob["warmup_s"], ob["penalty"], fit["tolerance"],
                      tg["use_inputs"], tg["input_upsample"], tg["input_periodic"], variables, settings, pol["kind"], pol["budget"], ga["pop_size"],
                      check_numbers(rep["truth"], path, "report.truth"), [tuple(p) for p in rep["products"]],
-                     rep["benchmark"])
+                     rep["benchmark"], nn["log_ratio"])

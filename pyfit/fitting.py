@@ -29,7 +29,7 @@ def ensure_target(cfg: FitConfig) -> pathlib.Path:
     s = cfg.synthetic
     spec = SyntheticSpec(cfg.model, s["excitation"], s["stop_time"], s["sample_rate_hz"], s["outputs"],
                          s["parameters"], s["noise_std"], s["oversample"], s["seed"], solver=s["solver"],
-                         anti_alias=s["anti_alias"])
+                         anti_alias=s["anti_alias"], passband_ripple_db=s["passband_ripple_db"])
     tmp = cfg.target_file.with_name(cfg.target_file.stem + ".partial.csv")
     write_synthetic(tmp, spec)
     tmp.with_suffix(".toml").replace(cfg.target_file.with_suffix(".toml"))
@@ -66,7 +66,7 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
     history, ann = [], []
     settings = dataclasses.replace(cfg.nno, seed=seed)
     if cfg.method in ("nno", "nno+polish"):
-        res = nno(obj.residuals, n, settings)
+        res = nno(obj.residuals, n, settings, transform=obj.log_ratio if cfg.nno_log_ratio else None)
         ann = [h for h in res.history if h.get("ann_error") is not None]
     elif cfg.method == "ga":
         res, _ = baselines.ga_direct(obj.residuals, n, cfg.budget, cfg.ga_pop_size, seed, stop_at)
@@ -154,8 +154,12 @@ def _figures(cfg, obj: Objective, x, history, ann, out_dir):
     ax.semilogy(ev, err, ".", ms=4, label="true (FMU) error")
     ax.semilogy(ev, np.minimum.accumulate(err), "-", label="best so far")
     if ann:
+        space = " (log-ratio search space)" if ann[0].get("searched_error") is not None else ""
         ax.semilogy([h["evaluations"] for h in ann], [max(h["ann_error"], 1e-300) for h in ann], "x", ms=4,
-                    label="ANN-predicted error at the GA optimum")
+                    label="ANN-predicted error at the GA optimum" + space)
+        if space:
+            ax.semilogy([h["evaluations"] for h in ann], [h["searched_error"] for h in ann], "+", ms=5,
+                        label="true error at the GA optimum" + space)
     ax.set_xlabel("true evaluations [-]")
     ax.set_ylabel("objective sum(r²) [-]")
     ax.legend(fontsize=8)

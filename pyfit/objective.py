@@ -162,6 +162,15 @@ class Objective:
         self.evaluations.append(Evaluation([float(v) for v in x], err, ok, message, time.perf_counter() - t0))
         return r
 
+    def log_ratio(self, r: np.ndarray) -> np.ndarray:
+        """A 'psd_band' residual vector as log(P/P_meas) per bin (log1p of the relative error, weights kept):
+        smooth in the parameters where the relative error spans decades (NNO's search transform)."""
+        if self.kind != "psd_band":
+            raise ValueError(f"log_ratio needs a psd_band objective, not '{self.kind}'")
+        root_w = np.concatenate([np.full(int(self._target[ch.output][1].sum()), np.sqrt(ch.weight))
+                                 for ch in self.channels])
+        return root_w * np.log(np.maximum(1.0 + r / root_w, 1e-12))
+
     def __call__(self, x) -> float:
         return float(np.sum(self.residuals(x) ** 2))
 

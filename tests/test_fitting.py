@@ -175,6 +175,9 @@ def test_fit_batch_writes_results_and_resumes_without_redoing(tmp_path, fmu_dir)
     (("alpha = [40000.0, 60000.0]", "alfa = [40000.0, 60000.0]"), "variables"),
     (('method = "nno"', 'method = "annealing"'), "fit.method"),
     (('[target.synthetic]', '[target.unused]'), "target.unused"),
+    (("ga_generations = 10", "ga_generations = 10\nlog_ratio = true"), "nno.log_ratio"),  # needs psd_band
+    (("stop_time = 3.0", "stop_time = 3.0\nanti_alias = false\npassband_ripple_db = 0.005"),
+     "target.synthetic.passband_ripple_db"),
 ])
 def test_bad_fit_config_names_file_and_key(tmp_path, fmu_dir, change, key):
     cfg = tmp_path / "tiny.toml"
@@ -215,3 +218,50 @@ def test_ga_baseline_runs_after_nno_and_stops_at_its_median(tmp_path, fmu_dir):
         assert r["true_evaluations"] == (evaluations_to_reach(r["global_best_so_far"], goal, 60) if reached else 40)
     summary = (out / "summary.md").read_text()
     assert "NNO vs GA (tiny vs tiny_ga, same problem)" in summary and "other_ga vs" not in summary
+
+
+def _resonance_log_psd_residuals(x):
+    """log-PSD misfit of a single resonance, f0 = 20 + 30 x0 Hz and zeta = 0.005 + 0.05 x1, on 121 bins in
+    20-50 Hz; the truth x* = (0.52, 0.3) is f0 = 35.6 Hz, zeta = 2 %."""
+    f = np.linspace(20.0, 50.0, 121)
+
+    def log_psd(u):
+        f0, zeta = 20.0 + 30.0 * u[0], 0.005 + 0.05 * u[1]
+        return -np.log((1 - (f / f0) ** 2) ** 2 + (2 * zeta * f / f0) ** 2)
+
+    return log_psd(np.asarray(x)) - log_psd(np.array([0.52, 0.3]))
+
+
+def test_trust_region_nno_pins_frequency_and_damping_of_a_resonance():
+    """Where a global surrogate cannot resolve a sharp resonance from 10-40 samples (it left zeta off by
+    0.07-0.16 in unit terms on seeds 0-2 when this test was written), the trust-region box keeps the GA where
+    the surrogate has been checked: f0 within 0.06 Hz and zeta within 1e-4 after 40 true evaluations."""
+    settings = NNOSettings(init_sim=10, max_sim=40, fun_tol=0.0, p_size=20, ga_generations=40, seed=2,
+                           trust_region=True)
+    tr = nno(_resonance_log_psd_residuals, 2, settings)
+    np.testing.assert_allclose(tr.x, [0.52, 0.3], atol=2e-3)
+    radii = [h["radius"] for h in tr.history if h.get("radius") is not None]
+    assert min(radii) < 0.5 and all(settings.x_tol <= r <= 0.5 for r in radii)
+
+
+def test_log_ratio_search_transform_is_log_of_the_psd_ratio(tmp_path, fmu_dir):
+    """The psd_band residual sqrt(w) (P - P_meas)/P_meas becomes sqrt(w) log(P/P_meas), the psd_log residual; the penalty
+    vector stays finite; other objective kinds refuse it."""
+    from pyfit.fitting import _objective, ensure_target
+    from pyfit.run_example import ensure_fmu
+
+    cfg_path = tmp_path / "tiny.toml"
+    cfg_path.write_text(TINY.replace('kind = "psd_log"', 'kind = "psd_band"')
+                        .replace('bands = [[30.0, 42.0]] }', 'bands = [[30.0, 42.0]], weight = 4.0 }'))
+    cfg = load_fit(cfg_path)
+    ensure_target(cfg)
+    fmu = ensure_fmu(cfg.model, fmu_dir)
+    band = _objective(cfg, fmu, read_measurement(cfg.target_file), "psd_band")
+    log = _objective(cfg, fmu, read_measurement(cfg.target_file), "psd_log")
+    x = np.array([0.8])
+    np.testing.assert_allclose(band.log_ratio(band.residuals(x)), log.residuals(x), rtol=1e-10, atol=1e-12)
+    assert np.all(np.isfinite(band.log_ratio(np.full(band.size, -1.0))))
+    with pytest.raises(ValueError, match="psd_band"):
+        log.log_ratio(log.residuals(x))
+    band.close()
+    log.close()

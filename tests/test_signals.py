@@ -90,3 +90,23 @@ def test_damper_power_and_impedance_from_a_slow_sweep_match_stepped_sines(runner
         assert p > 0
         assert p == pytest.approx(cyc.mean_power, rel=0.05)
         assert z == pytest.approx(cyc.impedance, rel=0.03)
+
+
+def test_daq_grade_anti_alias_fir_is_flat_where_scipy_default_is_not():
+    """The synthetic sensor chain: a Kaiser FIR designed for 0.005 dB ripple stays within it up to 0.7x the
+    sensor Nyquist (within 1.2x of it up to 0.8x) and attenuates by as much from the Nyquist on; scipy's
+    default decimation FIR (Hamming, 201 taps at q = 10) is +0.024 dB at 58 Hz of a 1 kHz sensor, the tilt
+    that biased the SDOF fit by 1.3 %."""
+    import scipy.signal
+
+    from pyfit.synthetic import anti_alias_fir
+
+    fs_fine, q = 10000.0, 10
+    ripple = 10 ** (0.005 / 20) - 1
+    fir = anti_alias_fir(q, 0.005)
+    _, h = scipy.signal.freqz(fir, worN=np.linspace(0.0, 400.0, 801), fs=fs_fine)
+    assert np.max(np.abs(np.abs(h[:701]) - 1)) <= ripple and np.max(np.abs(np.abs(h) - 1)) <= 1.2 * ripple
+    _, h_stop = scipy.signal.freqz(fir, worN=np.linspace(500.0, 4999.0, 2000), fs=fs_fine)
+    assert np.max(np.abs(h_stop)) <= 1.2 * ripple
+    _, h_default = scipy.signal.freqz(scipy.signal.firwin(201, 1 / q, window="hamming"), worN=[58.0], fs=fs_fine)
+    assert 20 * np.log10(abs(h_default[0])) > 0.02
