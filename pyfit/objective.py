@@ -99,6 +99,8 @@ class Objective:
                 self._target[ch.output] = (y, float(np.std(y)))
         if kind != "time":
             self.size = sum(int(mask.sum()) for _, mask in self._target.values())
+            self._root_w = np.concatenate([np.full(int(self._target[ch.output][1].sum()), np.sqrt(ch.weight))
+                                           for ch in channels])  # per-bin sqrt(weight), for log_ratio
         else:
             self.size = sum(len(y) for y, _ in self._target.values())
 
@@ -167,9 +169,7 @@ class Objective:
         smooth in the parameters where the relative error spans decades (NNO's search transform)."""
         if self.kind != "psd_band":
             raise ValueError(f"log_ratio needs a psd_band objective, not '{self.kind}'")
-        root_w = np.concatenate([np.full(int(self._target[ch.output][1].sum()), np.sqrt(ch.weight))
-                                 for ch in self.channels])
-        return root_w * np.log(np.maximum(1.0 + r / root_w, 1e-12))
+        return self._root_w * np.log(np.maximum(1.0 + r / self._root_w, 1e-12))
 
     def __call__(self, x) -> float:
         return float(np.sum(self.residuals(x) ** 2))

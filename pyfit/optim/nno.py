@@ -135,19 +135,20 @@ def nno(residuals, n_var: int, settings: NNOSettings, x0: np.ndarray | None = No
         r_new = residuals(x_new)
         err = float(np.sum(r_new**2))
         g_new = g(r_new)
+        searched_new = float(np.sum(g_new**2))
         if settings.trust_region:
             predicted = float(surrogate.predict_error(X[best][None])[0]) - ann_error
-            ratio = (searched[best] - float(np.sum(g_new**2))) / predicted if predicted > 0 else -1.0
+            ratio = (searched[best] - searched_new) / predicted if predicted > 0 else -1.0
             radius = min(2 * radius, 0.5) if ratio > 0.75 else max(radius / 2, settings.x_tol) if ratio < 0.25 \
                 else radius
         X.append(x_new)
         G.append(g_new)
         errors.append(err)
-        searched.append(float(np.sum(g_new**2)))
+        searched.append(searched_new)
         history.append({"iteration": it, "evaluations": len(X), "x": x_new.tolist(), "true_error": err,
                         "ann_error": ann_error, "ann_validation_loss": surrogate.validation_loss,
                         "radius": radius if settings.trust_region else None,
-                        "searched_error": float(np.sum(g_new**2)) if transform else None,
+                        "searched_error": searched_new if transform else None,
                         "wall_s": time.perf_counter() - t_start})
         if callback:
             callback(history[-1])
