@@ -10,7 +10,7 @@ import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from pyfit.batch import RunSpec, run_batch  # noqa: E402
+from pyfit.runtime.batch import RunSpec, run_batch  # noqa: E402
 from pyfit.build import EXAMPLES, build_fmu  # noqa: E402
 
 

@@ -13,7 +13,7 @@ import time
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from pyfit.build import EXAMPLES, build_fmu  # noqa: E402
-from pyfit.fmu import FmuRunner  # noqa: E402
+from pyfit.runtime.fmu import FmuRunner  # noqa: E402
 
 
 def rss_mib() -> float:

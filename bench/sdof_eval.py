@@ -21,9 +21,9 @@ from scipy.integrate import solve_ivp
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from pyfit import benchmark_data as bd  # noqa: E402
+from pyfit.io import benchmark_data as bd  # noqa: E402
 from pyfit.build import EXAMPLES, build_fmu  # noqa: E402
-from pyfit.fmu import FmuRunner  # noqa: E402
+from pyfit.runtime.fmu import FmuRunner  # noqa: E402
 
 M, C, K, ALPHA, BETA, GAMMA, DELTA, NU = 2.0, 10.0, 5e4, 5e4, 1e3, 0.8, -1.1, 1.0
 

@@ -10,7 +10,7 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from pyfit import crosscheck  # noqa: E402
+from pyfit.reference import crosscheck  # noqa: E402
 from pyfit.reference.models import NAMES  # noqa: E402
 
 

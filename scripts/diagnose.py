@@ -13,8 +13,9 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from pyfit import benchmark_data  # noqa: E402
-from pyfit.gap import cases, datasets  # noqa: E402
+from pyfit.io import benchmark_data  # noqa: E402
+from pyfit.gap import cases  # noqa: E402
+from pyfit.gap import datasets
 from pyfit.gap.diagnose import DiagnoseError, diagnose, load_config  # noqa: E402
 
 

@@ -8,8 +8,8 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from pyfit.fmu_docs import REFERENCE_RUNS, write_docs  # noqa: E402
-from pyfit.run_example import ensure_fmu  # noqa: E402
+from pyfit.build.element_docs import REFERENCE_RUNS, write_docs  # noqa: E402
+from pyfit.runtime.examples import ensure_fmu  # noqa: E402
 
 
 def main() -> int:

@@ -13,9 +13,9 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from pyfit import energy_balance as eb  # noqa: E402
-from pyfit.fmu import FmuRunner  # noqa: E402
-from pyfit.run_example import ensure_fmu  # noqa: E402
+from pyfit.design import energy_balance as eb  # noqa: E402
+from pyfit.runtime.fmu import FmuRunner  # noqa: E402
+from pyfit.runtime.examples import ensure_fmu  # noqa: E402
 
 
 def main() -> int:

@@ -12,9 +12,9 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from pyfit.config import ConfigError  # noqa: E402
-from pyfit.data import MeasurementError  # noqa: E402
-from pyfit.fit_batch import fit_batch  # noqa: E402
+from pyfit.io.sweep_config import ConfigError  # noqa: E402
+from pyfit.io.data import MeasurementError  # noqa: E402
+from pyfit.fit.batch import fit_batch  # noqa: E402
 
 DEFAULT = pathlib.Path(__file__).resolve().parents[1] / "configs" / "quickstart.toml"
 

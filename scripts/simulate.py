@@ -9,8 +9,8 @@ import sys
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from pyfit.build import EXAMPLES  # noqa: E402
-from pyfit.fmu import ParameterError  # noqa: E402
-from pyfit.run_example import run_example  # noqa: E402
+from pyfit.runtime.fmu import ParameterError  # noqa: E402
+from pyfit.runtime.examples import run_example  # noqa: E402
 
 
 def main() -> int:

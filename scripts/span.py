@@ -10,10 +10,10 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from pyfit.fmu import FmuRunner  # noqa: E402
-from pyfit.run_example import ensure_fmu  # noqa: E402
-from pyfit.span import CONNECTIONS, reduction_table, write_report  # noqa: E402
-from pyfit.ssp import write_ssp  # noqa: E402
+from pyfit.runtime.fmu import FmuRunner  # noqa: E402
+from pyfit.runtime.examples import ensure_fmu  # noqa: E402
+from pyfit.design.span import CONNECTIONS, reduction_table, write_report  # noqa: E402
+from pyfit.runtime.ssp import write_ssp  # noqa: E402
 
 
 def main() -> int:

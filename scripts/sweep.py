@@ -8,9 +8,9 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from pyfit.config import ConfigError, load_sweep  # noqa: E402
-from pyfit.run_example import ensure_fmu  # noqa: E402
-from pyfit.sweep import fmu_interface, run_study  # noqa: E402
+from pyfit.io.sweep_config import ConfigError, load_sweep  # noqa: E402
+from pyfit.runtime.examples import ensure_fmu  # noqa: E402
+from pyfit.runtime.sweep import fmu_interface, run_study  # noqa: E402
 
 
 def main() -> int:

@@ -4,7 +4,7 @@ import pathlib
 import pytest
 
 from pyfit.build import build_all
-from pyfit.fmu import FmuRunner
+from pyfit.runtime.fmu import FmuRunner
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SHARED_DATA = ROOT.parent / "shared" / "data" / "boucwen"

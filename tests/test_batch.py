@@ -3,8 +3,8 @@ import os
 
 import numpy as np
 
-from pyfit.batch import RunSpec, run_batch, run_one
-from pyfit.fmu import FmuRunner
+from pyfit.runtime.batch import RunSpec, run_batch, run_one
+from pyfit.runtime.fmu import FmuRunner
 
 
 def _sweep_specs(fmu):

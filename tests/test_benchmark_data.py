@@ -1,7 +1,7 @@
 """Real external data: the SDOF FMU against the official Bouc-Wen benchmark validation outputs."""
 import pytest
 
-from pyfit import benchmark_data as bd
+from pyfit.io import benchmark_data as bd
 
 if not bd.DEFAULT_DIR.is_dir():
     pytest.skip(f"benchmark data not found at {bd.DEFAULT_DIR}", allow_module_level=True)

@@ -6,11 +6,12 @@ import pathlib
 import numpy as np
 import pytest
 
-from pyfit import benchmark_data as bd
-from pyfit import signals
-from pyfit.fit_config import load_fit
-from pyfit.fitting import ensure_target, run_fit
-from pyfit.synthetic import MultisineInput, SyntheticSpec, simulate_truth
+from pyfit.io import benchmark_data as bd
+from pyfit.analysis import signals
+from pyfit.io.fit_config import load_fit
+from pyfit.fit.fitting import ensure_target, run_fit
+from pyfit.analysis.excitation import MultisineInput
+from pyfit.reference.synthetic import SyntheticSpec, simulate_truth
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 

@@ -8,7 +8,7 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
 from pyfit.build import EXAMPLES, LIBRARY, ModelicaError, build_all
-from pyfit.fmu import ParameterError
+from pyfit.runtime.fmu import ParameterError
 
 # name -> (outputs compared, parameters for a short nonlinear run, stop time [s])
 RUNS = {

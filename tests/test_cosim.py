@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from pyfit.cosim import Connection, cosimulate
+from pyfit.runtime.cosim import Connection, cosimulate
 
 EXC = dict(exc_type=2, exc_amplitude=120.0, exc_f_start=20.0, exc_f_end=50.0, exc_rate=15.0)  # through 35 Hz
 STOP = 2.0  # s

@@ -9,8 +9,8 @@ import scipy.integrate
 from fmpy.validation import validate_fmu
 
 from pyfit.build import EXAMPLES
-from pyfit.excitation import Excitation
-from pyfit.fmu_docs import REFERENCE_RUNS, motion_with_derivatives, write_docs
+from pyfit.analysis.excitation import Excitation
+from pyfit.build.element_docs import REFERENCE_RUNS, motion_with_derivatives, write_docs
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 

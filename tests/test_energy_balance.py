@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from damper_matrices import clamp_power
-from pyfit import energy_balance as eb
+from pyfit.design import energy_balance as eb
 
 DRAKE_LAB = eb.Conductor(eb.DRAKE_DIAMETER, 1.628, 28e3, 30.0, 0.002)
 DRAKE_FIELD = eb.Conductor(eb.DRAKE_DIAMETER, 1.628, 28e3, 300.0, 2e-4)

@@ -7,15 +7,15 @@ import textwrap
 import numpy as np
 import pytest
 
-from pyfit.config import ConfigError
-from pyfit.data import MeasurementError, read_measurement, write_measurement
-from pyfit.fit_batch import evaluations_to_reach, fit_batch
-from pyfit.fit_config import load_fit
-from pyfit.objective import FreeParameter
-from pyfit.optim import baselines
-from pyfit.optim.nno import NNOSettings, nno
-from pyfit.optim.surrogate import Surrogate
-from pyfit.sweep import fmu_interface
+from pyfit.io.sweep_config import ConfigError
+from pyfit.io.data import MeasurementError, read_measurement, write_measurement
+from pyfit.fit.batch import evaluations_to_reach, fit_batch
+from pyfit.io.fit_config import load_fit
+from pyfit.io.fit_config import FreeParameter, NNOSettings
+from pyfit.fit.optim import baselines
+from pyfit.fit.optim.nno import nno
+from pyfit.fit.optim.surrogate import Surrogate
+from pyfit.runtime.sweep import fmu_interface
 
 
 def test_only_beta_gamma_and_beta_delta_are_identifiable(runner):
@@ -247,8 +247,8 @@ def test_trust_region_nno_pins_frequency_and_damping_of_a_resonance():
 def test_log_ratio_search_transform_is_log_of_the_psd_ratio(tmp_path, fmu_dir):
     """The psd_band residual sqrt(w) (P - P_meas)/P_meas becomes sqrt(w) log(P/P_meas), the psd_log residual; the penalty
     vector stays finite; other objective kinds refuse it."""
-    from pyfit.fitting import _objective, ensure_target
-    from pyfit.run_example import ensure_fmu
+    from pyfit.fit.fitting import _objective, ensure_target
+    from pyfit.runtime.examples import ensure_fmu
 
     cfg_path = tmp_path / "tiny.toml"
     cfg_path.write_text(TINY.replace('kind = "psd_log"', 'kind = "psd_band"')

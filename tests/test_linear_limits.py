@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from damper_matrices import clamped_matrices
-from pyfit.modal import free_decay_modes, state_space_modes
+from pyfit.analysis.modal import free_decay_modes, state_space_modes
 
 DT = 5e-4
 

@@ -2,9 +2,10 @@
 import numpy as np
 import pytest
 
-from pyfit import crosscheck
-from pyfit.excitation import Excitation
-from pyfit.reference import integrate, models
+from pyfit.reference import crosscheck
+from pyfit.analysis.excitation import Excitation
+from pyfit.reference import integrate
+from pyfit.reference import models
 
 
 @pytest.mark.parametrize("name", models.NAMES)

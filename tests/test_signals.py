@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from pyfit import signals
-from pyfit.excitation import multisine
+from pyfit.analysis import signals
+from pyfit.analysis.excitation import multisine
 
 
 def test_psd_of_a_sine_peaks_at_its_frequency_and_integrates_to_its_variance():
@@ -72,7 +72,7 @@ def test_damper_power_at_constant_velocity_is_positive_and_equals_loop_area(runn
 
 
 def test_damper_power_and_impedance_from_a_slow_sweep_match_stepped_sines(runner):
-    from pyfit.excitation import Excitation
+    from pyfit.analysis.excitation import Excitation
 
     v0, rate = 0.03, 0.25
     exc = Excitation(4, v0, 5.0, 30.0, rate, t_ramp=1.0)
@@ -99,7 +99,7 @@ def test_daq_grade_anti_alias_fir_is_flat_where_scipy_default_is_not():
     that biased the SDOF fit by 1.3 %."""
     import scipy.signal
 
-    from pyfit.synthetic import anti_alias_fir
+    from pyfit.reference.synthetic import anti_alias_fir
 
     fs_fine, q = 10000.0, 10
     ripple = 10 ** (0.005 / 20) - 1

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from pyfit.cosim import cosimulate
-from pyfit.span import mode_decay
+from pyfit.runtime.cosim import cosimulate
+from pyfit.design.span import mode_decay
 
 C = np.sqrt(28000.0 / 1.628)  # m/s, wave speed of the default span (T = 28 kN, m_l = 1.628 kg/m)
 

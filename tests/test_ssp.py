@@ -5,8 +5,8 @@ import numpy as np
 from fmpy.ssp.simulation import simulate_ssp
 from fmpy.ssp.ssd import read_ssd
 
-from pyfit.cosim import Connection
-from pyfit.ssp import write_ssp
+from pyfit.runtime.cosim import Connection
+from pyfit.runtime.ssp import write_ssp
 
 EXC = {"exc_type": 2, "exc_amplitude": 120.0, "exc_f_start": 20.0, "exc_f_end": 50.0, "exc_rate": 15.0}
 CONNECTIONS = [Connection("mass.y", "bw.s", "mass.v"), Connection("mass.v", "bw.v", "mass.a"),

@@ -5,9 +5,9 @@ import textwrap
 import numpy as np
 import pytest
 
-from pyfit.config import ConfigError, load_sweep
-from pyfit.fmu import FmuRunner
-from pyfit.sweep import fmu_interface, run_study
+from pyfit.io.sweep_config import ConfigError, load_sweep
+from pyfit.runtime.fmu import FmuRunner
+from pyfit.runtime.sweep import fmu_interface, run_study
 
 STUDY = """
 [study]

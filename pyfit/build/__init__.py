@@ -8,29 +8,9 @@ import pathlib
 import tempfile
 from dataclasses import dataclass
 
-from . import codegen, frontend, package, reduce
-from .frontend import ModelicaError
+from pyfit.build.catalog import EXAMPLES, LIBRARY, ModelicaError
 
 __all__ = ["ModelicaError", "EXAMPLES", "build_fmu", "build_all", "LIBRARY"]
-
-LIBRARY = pathlib.Path(__file__).resolve().parents[2] / "modelica"
-
-# Exported examples: FMU file stem -> Modelica class
-EXAMPLES = {
-    "SDOFBoucWen": "StockbridgeDamper.Examples.SDOFBoucWen",
-    "TwoDOFa": "StockbridgeDamper.Examples.TwoDOFa",
-    "TwoDOFb": "StockbridgeDamper.Examples.TwoDOFb",
-    "TwoDOFc": "StockbridgeDamper.Examples.TwoDOFc",
-    "TwoDOFd": "StockbridgeDamper.Examples.TwoDOFd",
-    "StockbridgeDamper": "StockbridgeDamper.Examples.StockbridgeDamper",
-    # element FMUs for exchange and co-simulation (causal interfaces)
-    "BoucWenElement": "StockbridgeDamper.Elements.BoucWenElement",
-    "BoucWenNormalizedElement": "StockbridgeDamper.Elements.BoucWenNormalizedElement",
-    "CubicSpringElement": "StockbridgeDamper.Elements.CubicSpringElement",
-    "MassSpringDamper": "StockbridgeDamper.Elements.MassSpringDamper",
-    "DamperElement": "StockbridgeDamper.Elements.DamperElement",
-    "ConductorSpan": "StockbridgeDamper.Elements.ConductorSpan",
-}
 
 
 @dataclass
@@ -45,6 +25,8 @@ class BuildResult:
 def build_fmu(model_name: str, out_dir: pathlib.Path, ident: str | None = None,
               library: pathlib.Path = LIBRARY) -> BuildResult:
     """Build one Modelica class into `<out_dir>/<ident>.fmu` (FMI 2.0, Model Exchange + Co-Simulation)."""
+    from pyfit.build import codegen, frontend, package, reduce  # the compiler loads only when building
+
     ident = ident or model_name.split(".")[-1]
     flat = frontend.load(library, model_name)
     model = reduce.reduce_model(flat)
@@ -61,6 +43,8 @@ def build_fmu(model_name: str, out_dir: pathlib.Path, ident: str | None = None,
 def build_all(out_dir: pathlib.Path, names: list[str] | None = None, library: pathlib.Path = LIBRARY,
               on_built=None) -> list[BuildResult]:
     """Build every exported example (or the ones named); the library is checked before anything is written."""
+    from pyfit.build import frontend
+
     frontend.parse_library(library)
     names = names or list(EXAMPLES)
     unknown = [n for n in names if n not in EXAMPLES]

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import casadi as ca
 
-from .reduce import ExplicitModel
+from pyfit.build.reduce import ExplicitModel
 
 CS_STEP_NAME = "cs_step"
 CS_STEP_DESCRIPTION = ("Co-simulation only: fixed Runge-Kutta 4 sub-step in s; 0 selects the adaptive "

@@ -15,13 +15,10 @@ import casadi as ca
 if not hasattr(ca.MX, "__div__"):
     ca.MX.__div__ = ca.MX.__truediv__
 
+from pyfit.build.catalog import ModelicaError  # noqa: E402
 from pymoca import parser as mo_parser  # noqa: E402
 from pymoca import tree as mo_tree  # noqa: E402
 from pymoca.backends.casadi.api import generate_model  # noqa: E402
-
-
-class ModelicaError(Exception):
-    """A problem in the Modelica sources, naming the file (and line where known)."""
 
 
 @dataclass

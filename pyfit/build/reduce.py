@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import casadi as ca
 
-from .frontend import FlatModel, ModelicaError, Variable
+from pyfit.build.frontend import FlatModel, ModelicaError, Variable
 
 
 @dataclass

@@ -9,10 +9,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..fmu import FmuRunner
-from ..optim.baselines import polish
-from . import simulate as sim
-from .systems import Effect, Scale, System
+from pyfit.runtime.fmu import FmuRunner
+from pyfit.fit.optim.baselines import polish
+from pyfit.gap import simulate as sim
+from pyfit.gap.systems import Effect, Scale, System
 
 
 @dataclass

@@ -7,7 +7,7 @@ import json
 import pathlib
 import time
 
-from .diagnose import DiagnoseConfig, diagnose
+from pyfit.gap.diagnose import DiagnoseConfig, diagnose
 
 
 def run_cases(root, out_dir, cfg: DiagnoseConfig | None = None, model: str = "sdof", fmu_dir="fmus",

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..data import write_measurement
-from ..excitation import PeriodicSignal, multisine
-from ..synthetic import SyntheticSpec, simulate_truth
+from pyfit.io.data import write_measurement
+from pyfit.analysis.excitation import PeriodicSignal, multisine
+from pyfit.reference.synthetic import SyntheticSpec, simulate_truth
 
 
 @dataclass(frozen=True)

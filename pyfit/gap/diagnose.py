@@ -9,15 +9,15 @@ import pathlib
 from dataclasses import asdict, dataclass, fields
 
 
-from ..batch import map_tasks
-from ..data import MeasurementError, read_dataset
-from ..fmu import FmuRunner
-from ..run_example import ensure_fmu
-from ..tomlfile import read_toml
-from . import localise
-from . import simulate as sim
-from .attribute import Fit, effect_task, nominal_task, run_fit, screen
-from .systems import get_system
+from pyfit.runtime.batch import map_tasks
+from pyfit.io.data import MeasurementError, read_dataset
+from pyfit.runtime.fmu import FmuRunner
+from pyfit.runtime.examples import ensure_fmu
+from pyfit.io.schema import read_toml
+from pyfit.gap import localise
+from pyfit.gap import simulate as sim
+from pyfit.gap.attribute import Fit, effect_task, nominal_task, run_fit, screen
+from pyfit.gap.systems import get_system
 
 
 class DiagnoseError(ValueError):
@@ -132,7 +132,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     """Diagnose the dataset against the nominal model `model` ('sdof' or 'damper'); writes OUT/report.json,
     OUT/report.md and figures; returns the report. When the nominal model already fits the held-out files
     within the noise floor, no effect is refitted (verdict 'no significant gap')."""
-    from . import report
+    from pyfit.gap import report
 
     cfg = cfg or DiagnoseConfig()
     system = get_system(model)

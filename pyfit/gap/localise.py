@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .simulate import Record
+from pyfit.gap.simulate import Record
 
 LOOP_REGIONS = ("centre, loading", "centre, unloading", "tips, loading", "tips, unloading")
 

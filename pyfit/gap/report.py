@@ -7,9 +7,9 @@ import pathlib
 
 import numpy as np
 
-from .. import plots
-from . import localise
-from . import simulate as sim
+from pyfit.analysis import plots
+from pyfit.gap import localise
+from pyfit.gap import simulate as sim
 
 
 def _rms_over(values) -> float:
@@ -137,39 +137,27 @@ def separation(runner, result, records, fits, bands, upsample, lead_periods=1) -
 
 def write(result: dict, records, held, sims, bands, out_dir) -> pathlib.Path:
     """report.json, report.md, gap_map.png (band x level, nominal model) and overlay.png (held-out file)."""
-    import matplotlib.pyplot as plt
 
     out = pathlib.Path(out_dir)
     (out / "report.json").write_text(json.dumps(result, indent=1))
     # gap map: the nominal model's misfit per band (rows) and file (columns)
     M = np.array([[np.nan] * len(bands) if sims["nominal"][r.name] is None
                   else localise.by_band(sims["nominal"][r.name], r, bands) for r in records]).T
-    fig, ax = plt.subplots(figsize=(1.6 + 1.1 * len(records), 3.8))
-    im = ax.imshow(M, aspect="auto", origin="lower", cmap="viridis")
-    ax.set_xticks(range(len(records)), [r.level + (" *" if r in held else "") for r in records], fontsize=7,
-                  rotation=20)
-    ax.set_yticks(range(len(bands)), [f"{lo:.1f}-{hi:.1f}" for lo, hi in bands], fontsize=7)
-    ax.set_ylabel("band [Hz]")
-    ax.set_title("nominal model: NRMSE contribution per band and level (* held out)", fontsize=8)
-    fig.colorbar(im, ax=ax)
-    plots._save(fig, out / "gap_map.png")
+    plots.heat_map(out / "gap_map.png", M, [r.level + (" *" if r in held else "") for r in records],
+                   [f"{lo:.1f}-{hi:.1f}" for lo, hi in bands], "band [Hz]",
+                   "nominal model: NRMSE contribution per band and level (* held out)")
     # overlay on the first held-out file: measured, nominal, chosen effect (amplitude spectra)
     rec = held[0]
     k = next(iter(rec.outputs))
     f = np.fft.rfftfreq(rec.n, 1.0 / rec.fs)
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    ax.semilogy(f, np.abs(np.fft.rfft(rec.outputs[k])), "k", lw=0.8, label="measured")
+    sel = (f >= 0.5 * bands[0][0]) & (f <= min(rec.fs / 2, 1.5 * bands[-1][1]))
+    curves = [("measured", f[sel], np.abs(np.fft.rfft(rec.outputs[k]))[sel], "k-")]
     for name in ["nominal"] + ([result["chosen_effect"]] if result["chosen_effect"] else []):
         if sims[name][rec.name] is not None:
-            ax.semilogy(f, np.abs(np.fft.rfft(sims[name][rec.name][k] - rec.outputs[k])), lw=0.7,
-                        label=f"residual, {name}")
-    lo, hi = bands[0][0], bands[-1][1]
-    ax.set_xlim(0.5 * lo, min(rec.fs / 2, 1.5 * hi))
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel(f"|DFT| of {k} [m]")
-    ax.set_title(f"held-out file {rec.name}: output and residual spectra", fontsize=8)
-    ax.legend(fontsize=7)
-    plots._save(fig, out / "overlay.png")
+            curves.append((f"residual, {name}", f[sel], np.abs(np.fft.rfft(sims[name][rec.name][k] - rec.outputs[k]))[sel],
+                           "-"))
+    plots.semilogy_curves(out / "overlay.png", curves, "frequency [Hz]", f"|DFT| of {k} [SI]",
+                          f"held-out file {rec.name}: output and residual spectra")
     md = out / "report.md"
     md.write_text(markdown(result))
     return md

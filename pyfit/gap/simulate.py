@@ -7,9 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..data import Measurement
-from ..fmu import FmuRunner
-from ..signals import periodic_drive, upsample_spline
+from pyfit.io.data import Measurement
+from pyfit.runtime.fmu import FmuRunner
+from pyfit.runtime.drive import drive
 
 
 @dataclass
@@ -55,25 +55,9 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
              tolerance: float = 1e-8) -> dict | None:
     """Outputs (model variable -> samples on the record's grid) for FMU parameters params; None on failure.
     A periodic record is preceded by lead_periods simulated periods (dropped)."""
-    q = upsample
-    if rec.periodic:
-        spp = rec.samples_per_period
-        periods = rec.n // spp
-        fine = {k: periodic_drive(v[:spp], q, periods + lead_periods) for k, v in rec.inputs.items()}
-        skip = lead_periods * spp * q
-    else:
-        fine = {k: upsample_spline(v, q) for k, v in rec.inputs.items()}
-        skip = 0
-    n_fine = len(next(iter(fine.values())))
-    t = np.arange(n_fine) / (rec.fs * q)
-    res = runner.simulate(t[-1], 1.0 / (rec.fs * q), list(rec.outputs), params, inputs=fine, input_time=t,
-                          tolerance=tolerance)
-    if not res.ok:
-        return None
-    out = {k: res[k][skip::q][:rec.n] for k in rec.outputs}
-    if not all(len(v) == rec.n and np.all(np.isfinite(v)) for v in out.values()):
-        return None
-    return out
+    res = drive(runner, rec.inputs, rec.fs, list(rec.outputs), params, upsample, rec.samples_per_period,
+                lead_periods if rec.periodic else 0, tolerance)
+    return res.values if res.ok else None
 
 
 def residuals(sim: dict | None, rec: Record, penalty: float = 10.0) -> np.ndarray:

@@ -7,8 +7,8 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from ..excitation import Excitation
-from .models import ReferenceModel
+from pyfit.analysis.excitation import Excitation
+from pyfit.reference.models import ReferenceModel
 
 
 def _input_expr(model: ReferenceModel, excitation: Excitation | None, t: ca.SX) -> ca.SX:

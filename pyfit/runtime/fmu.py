@@ -82,7 +82,8 @@ class FmuRunner:
         """Names of the parameters that can be set before a run."""
         return [v.name for v in self.model_description.modelVariables if v.causality == "parameter"]
 
-    def _instance(self):
+    def instance(self):
+        """The loaded fmpy FMU instance of this process (instantiated on first use; reset between runs)."""
         if "fmu" not in self._state:
             md = self.model_description
             unzip = extract(self.path)
@@ -129,7 +130,7 @@ class FmuRunner:
 
     def _check_inputs(self, inputs: dict, input_time) -> None:
         """Input samples must be finite and on one uniform, increasing time column."""
-        from .signals import assert_uniform
+        from pyfit.analysis.signals import assert_uniform
 
         if input_time is None:
             raise ValueError("inputs given without input_time")
@@ -146,7 +147,8 @@ class FmuRunner:
                 raise ValueError(f"input '{name}' is not finite at {bad.size} sample(s), first at "
                                  f"t = {input_time[bad[0]]:g} s")
 
-    def _apply(self, fmu, params: dict):
+    def set_parameters(self, fmu, params: dict) -> None:
+        """Set parameters (Real, Integer or Boolean by their declared type) on a loaded instance."""
         for name, value in params.items():
             v = self.variables[name]
             if v.type == "Integer":
@@ -179,7 +181,7 @@ class FmuRunner:
                              f"output intervals {output_interval}")
         time = start_time + output_interval * np.arange(n + 1)
         try:
-            fmu = self._instance()
+            fmu = self.instance()
             self._state["log"].clear()
             fmu.reset()
             if self.interface == "CoSimulation":
@@ -197,7 +199,7 @@ class FmuRunner:
 
     def _run_cs(self, fmu, time, outputs, params, inputs, input_time, tolerance):
         fmu.setupExperiment(tolerance=tolerance, startTime=time[0])
-        self._apply(fmu, params)
+        self.set_parameters(fmu, params)
         fmu.enterInitializationMode()
         fmu.exitInitializationMode()
         out_vr = (ctypes.c_uint * len(outputs))(*[self.variables[o].valueReference for o in outputs])

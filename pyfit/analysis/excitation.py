@@ -7,7 +7,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import casadi as ca
 import numpy as np
 
 KINDS = {0: "off", 1: "sine", 2: "linear sweep", 3: "log sweep", 4: "constant-velocity linear sweep",
@@ -81,13 +80,22 @@ class Excitation:
         return a * xp.sin(self.phase(t))
 
 
-class _Casadi:
-    minimum = staticmethod(ca.fmin)
-    sin = staticmethod(ca.sin)
+def _is_symbolic(t) -> bool:
+    """A CasADi expression (CasADi itself is imported only when one is passed)."""
+    return type(t).__module__.startswith("casadi")
 
 
 def _ops(t):
-    return _Casadi if isinstance(t, (ca.SX, ca.MX)) else np
+    """numpy, or CasADi's functions of the same names for a symbolic t."""
+    if not _is_symbolic(t):
+        return np
+    import casadi as ca
+
+    class _Casadi:
+        minimum = staticmethod(ca.fmin)
+        sin = staticmethod(ca.sin)
+
+    return _Casadi
 
 
 def multisine(n_samples: int, fs: float, f_min: float, f_max: float, rms: float, seed: int = 0,
@@ -113,6 +121,24 @@ def multisine(n_samples: int, fs: float, f_min: float, f_max: float, rms: float,
     spec[band] = np.exp(2j * np.pi * rng.random(band.sum()))
     u = np.fft.irfft(spec, n_samples)
     return u * rms / np.sqrt(np.mean(u**2))
+
+
+@dataclass(frozen=True)
+class MultisineInput:
+    """A force input of whole periods of a random-phase multisine: band [Hz], RMS [N], samples per period."""
+
+    f_min: float
+    f_max: float
+    rms: float
+    samples_per_period: int
+    periods: int
+    seed: int = 0
+    odd: bool = False  # random-odd multisine (detection lines for odd/even distortion)
+
+    def __call__(self, fs: float) -> np.ndarray:
+        """All periods at the sensor rate fs [Hz]."""
+        return np.tile(multisine(self.samples_per_period, fs, self.f_min, self.f_max, self.rms, self.seed,
+                                 self.odd), self.periods)
 
 
 class PeriodicSignal:
@@ -141,7 +167,9 @@ class PeriodicSignal:
                                                                   + order * np.pi / 2), axis=0).reshape(t.shape)
 
     def __call__(self, t):
-        if isinstance(t, (ca.SX, ca.MX)):
+        if _is_symbolic(t):
+            import casadi as ca
+
             out = self.mean
             for a, w, p in zip(self.amplitudes, self.omegas, self.phases):
                 out = out + a * ca.cos(w * t + p)

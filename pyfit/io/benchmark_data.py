@@ -11,7 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.io
 
-from .signals import periodic_drive, rms_db, upsample_spline  # noqa: F401  (rms_db: the figure of merit)
+from pyfit.analysis.signals import rms_db  # noqa: F401  (rms_db: the figure of merit)
+from pyfit.runtime.drive import drive
 
 FS_HZ = 750.0  # sampling frequency of the official signals (not stored in the files)
 # ../shared/data/boucwen beside the repository, or the folder named by BOUCWEN_DATA_DIR
@@ -50,29 +51,20 @@ def simulate_validation(runner, signal: ValidationSignal, upsample: int = 20, pe
     Multisine: band-limited upsampling, `periods` periods, the last one returned (steady state).
     Sweep: spline upsampling, from rest.
     """
-    fs = FS_HZ * upsample
-    if signal.periodic:
-        u = periodic_drive(signal.u, upsample, periods)
-    else:
-        u = upsample_spline(signal.u, upsample)
-    t = np.arange(len(u)) / fs
     p = {"exc_type": 0}
     p.update(params or {})
-    res = runner.simulate(stop_time=t[-1], output_interval=1 / fs, outputs=["y"], params=p, inputs={"u": u},
-                          input_time=t, tolerance=tolerance)
+    n = len(signal.u)
+    res = drive(runner, {"u": signal.u}, FS_HZ, ["y"], p, upsample, n if signal.periodic else None,
+                periods - 1 if signal.periodic else 0, tolerance)
     if not res.ok:
         raise RuntimeError(f"benchmark simulation failed: {res.message}")
-    y = res["y"][::upsample]
-    if signal.periodic:
-        n = len(signal.u)
-        return y[(periods - 1) * n:periods * n]
-    return y[:len(signal.u)]
+    return res["y"]
 
 
 def write_dataset(out_dir, folder: pathlib.Path = DEFAULT_DIR) -> pathlib.Path:
     """The two official signals as a design-section-5 dataset (for the gap-diagnosis demonstration that
     the data README allows: calibrate on the multisine, judge on the sweep)."""
-    from .data import write_measurement
+    from pyfit.io.data import write_measurement
 
     out = pathlib.Path(out_dir)
     for name in ("multisine", "sinesweep"):

@@ -18,31 +18,14 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.signal
 
-from . import signals
-from .data import write_measurement
-from .excitation import Excitation, multisine
-from .reference import integrate, models
+from pyfit.analysis import signals
+from pyfit.io.data import write_measurement
+from pyfit.analysis.excitation import Excitation, MultisineInput
+from pyfit.reference import integrate
+from pyfit.reference import models
 
 UNITS = {"y": "m", "y1": "m", "y2": "m", "x1": "m", "x2": "m", "xg1": "m", "xg2": "m", "F_clamp": "N",
          "z": "N", "v": "m/s", "v1": "m/s", "v2": "m/s", "phi1": "rad", "phi2": "rad"}
-
-
-@dataclass(frozen=True)
-class MultisineInput:
-    """A force input of whole periods of a random-phase multisine: band [Hz], RMS [N], samples per period."""
-
-    f_min: float
-    f_max: float
-    rms: float
-    samples_per_period: int
-    periods: int
-    seed: int = 0
-    odd: bool = False  # random-odd multisine (detection lines for odd/even distortion)
-
-    def __call__(self, fs: float) -> np.ndarray:
-        """All periods at the sensor rate fs [Hz]."""
-        return np.tile(multisine(self.samples_per_period, fs, self.f_min, self.f_max, self.rms, self.seed,
-                                 self.odd), self.periods)
 
 
 @dataclass

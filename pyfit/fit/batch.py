@@ -7,11 +7,11 @@ import traceback
 
 import numpy as np
 
-from .batch import map_tasks
-from .fit_config import load_fit
-from .fitting import ensure_target, run_fit
-from .run_example import ensure_fmu
-from .sweep import fmu_interface
+from pyfit.runtime.batch import map_tasks
+from pyfit.io.fit_config import load_fit
+from pyfit.fit.fitting import ensure_target, run_fit
+from pyfit.runtime.examples import ensure_fmu
+from pyfit.runtime.sweep import fmu_interface
 
 
 def _parameters_of(fmu_dir):

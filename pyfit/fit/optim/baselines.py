@@ -9,11 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.optimize
-from pymoo.algorithms.soo.nonconvex.ga import GA
-from pymoo.core.problem import ElementwiseProblem
-from pymoo.optimize import minimize
 
-from .nno import OptimResult, sobol_points
+from pyfit.fit.optim.result import OptimResult
 
 
 class _Budget(Exception):
@@ -55,6 +52,10 @@ def ga_direct(residuals, n_var: int, budget: int, pop_size: int = 20, seed: int 
               target: float | None = None) -> tuple[OptimResult, int | None]:
     """The GA applied directly to the FMU objective (the seed's comparison). Returns the result and the
     number of evaluations at which the error first reached `target` (None if never)."""
+    from pymoo.algorithms.soo.nonconvex.ga import GA
+    from pymoo.core.problem import ElementwiseProblem
+    from pymoo.optimize import minimize
+
     counter = CountingResiduals(residuals, budget, target)
 
     class P(ElementwiseProblem):
@@ -97,11 +98,6 @@ def polish(residuals, x0: np.ndarray, budget: int = 200, diff_step: float = 1e-4
     except _Budget:
         reason = "budget"
     return counter.result(reason)
-
-
-def initial_design(n: int, n_var: int, seed: int) -> np.ndarray:
-    """The space-filling design shared with NNO."""
-    return sobol_points(n, n_var, seed)
 
 
 @dataclass

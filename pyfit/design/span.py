@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import plots
-from .cosim import Connection, cosimulate
-from .fmu import FmuRunner
+from pyfit.analysis import plots
+from pyfit.runtime.cosim import Connection, cosimulate
+from pyfit.runtime.fmu import FmuRunner
 
 CONNECTIONS = [Connection("span.y_d", "damper.x_base", "span.v_d"),
                Connection("span.v_d", "damper.v_base", "span.a_d"),
@@ -81,7 +81,6 @@ def reduction_table(span_fmu, damper_fmu, modes, positions, **kw) -> list[ModeDe
 
 def write_report(rows: list[ModeDecay], out_dir) -> None:
     """reduction.md (table per mode and position), reduction.csv and reduction.png into out_dir."""
-    import matplotlib.pyplot as plt  # only when a report is written
 
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -101,13 +100,7 @@ def write_report(rows: list[ModeDecay], out_dir) -> None:
                      + " | ".join(f"{by[n, x].amplitude_ratio:.3f}" for x in positions) + " |")
     (out / "reduction.md").write_text("Resonant amplitude with the damper / without it (same modal force):\n\n"
                                       + "\n".join(lines) + "\n")
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    for x in positions:
-        ax.plot([by[n, x].frequency_hz for n in modes], [by[n, x].amplitude_ratio for n in modes], "o-", ms=3,
-                label=f"damper at {x:g} m")
-    ax.set_xlabel("mode frequency [Hz]")
-    ax.set_ylabel("resonant amplitude ratio [-]")
-    ax.set_ylim(0, 1.05)
-    ax.legend(fontsize=8)
-    ax.set_title("Span with a Stockbridge damper: amplitude with / without damper", fontsize=9)
-    plots._save(fig, out / "reduction.png")
+    plots.semilogy_curves(out / "reduction.png", [
+        (f"damper at {x:g} m", [by[n, x].frequency_hz for n in modes], [by[n, x].amplitude_ratio for n in modes],
+         "o-") for x in positions], "mode frequency [Hz]", "resonant amplitude ratio [-]",
+        "Span with a Stockbridge damper: amplitude with / without damper", ylim=(0, 1.05), log=False)

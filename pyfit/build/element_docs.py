@@ -7,8 +7,8 @@ import pathlib
 import casadi as ca
 import numpy as np
 
-from .excitation import Excitation
-from .fmu import FmuRunner
+from pyfit.analysis.excitation import Excitation
+from pyfit.runtime.fmu import FmuRunner
 
 STEP = 1e-3  # s, output interval of the reference runs and spacing of their (linear) input samples
 STOP = 0.5  # s

@@ -10,14 +10,16 @@ from dataclasses import asdict
 
 import numpy as np
 
-from . import __version__, benchmark_data, plots, signals
-from .data import read_measurement
-from .fit_config import FitConfig
-from .objective import Objective
-from .optim import baselines
-from .optim.nno import nno
-from .run_example import ensure_fmu
-from .synthetic import SyntheticSpec, write_synthetic
+from pyfit import __version__
+from pyfit.analysis import plots
+from pyfit.io import benchmark_data
+from pyfit.io.data import read_measurement
+from pyfit.io.fit_config import FitConfig
+from pyfit.fit.objective import Objective
+from pyfit.fit.optim import baselines
+from pyfit.fit.optim.nno import nno
+from pyfit.runtime.examples import ensure_fmu
+from pyfit.reference.synthetic import SyntheticSpec, write_synthetic
 
 
 def ensure_target(cfg: FitConfig) -> pathlib.Path:
@@ -113,22 +115,16 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
 def benchmark_validation(obj: Objective, x, out_dir: pathlib.Path) -> dict[str, float]:
     """RMS error [dB re 1 m] of the fitted model on the official Bouc-Wen validation signals (never used to
     estimate), with a figure of the error signals."""
-    import matplotlib.pyplot as plt
-
     params = obj.params(x)
-    out = {}
-    fig, axes = plt.subplots(2, 1, figsize=(7, 5))
-    for ax, (name, upsample) in zip(axes, (("multisine", 20), ("sinesweep", 4))):
+    out, panels = {}, []
+    for name, upsample in (("multisine", 20), ("sinesweep", 4)):
         sig = benchmark_data.load(name)
         y = benchmark_data.simulate_validation(obj.runner, sig, upsample=upsample, params=params)
         out[name] = benchmark_data.rms_db(y - sig.y)
-        t = np.arange(len(y)) / benchmark_data.FS_HZ
-        ax.plot(t, 1e6 * (y - sig.y), lw=0.5)
-        ax.set_xlabel("time [s]")
-        ax.set_ylabel("y_model − y_official [µm]")
-        ax.set_title(f"{name}: RMS error {out[name]:.1f} dB re 1 m (official output RMS "
-                     f"{1e6 * np.sqrt(np.mean(sig.y ** 2)):.0f} µm)", fontsize=9)
-    plots._save(fig, out_dir / "benchmark_validation.png")
+        panels.append((f"{name}: RMS error {out[name]:.1f} dB re 1 m (official output RMS "
+                       f"{1e6 * np.sqrt(np.mean(sig.y ** 2)):.0f} µm)", np.arange(len(y)) / benchmark_data.FS_HZ,
+                       1e6 * (y - sig.y)))
+    plots.error_signals(out_dir / "benchmark_validation.png", panels, "y_model − y_official [µm]")
     return out
 
 
@@ -146,25 +142,7 @@ def recovery(fitted: dict, cfg: FitConfig) -> dict:
 
 
 def _figures(cfg, obj: Objective, x, history, ann, out_dir):
-    import matplotlib.pyplot as plt
-
-    ev = [h["evaluations"] for h in history]
-    err = [h["true_error"] for h in history]
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    ax.semilogy(ev, err, ".", ms=4, label="true (FMU) error")
-    ax.semilogy(ev, np.minimum.accumulate(err), "-", label="best so far")
-    if ann:
-        space = " (log-ratio search space)" if ann[0].get("searched_error") is not None else ""
-        ax.semilogy([h["evaluations"] for h in ann], [max(h["ann_error"], 1e-300) for h in ann], "x", ms=4,
-                    label="ANN-predicted error at the GA optimum" + space)
-        if space:
-            ax.semilogy([h["evaluations"] for h in ann], [h["searched_error"] for h in ann], "+", ms=5,
-                        label="true error at the GA optimum" + space)
-    ax.set_xlabel("true evaluations [-]")
-    ax.set_ylabel("objective sum(r²) [-]")
-    ax.legend(fontsize=8)
-    ax.set_title(f"{cfg.path.stem}: convergence ({cfg.method})")
-    plots._save(fig, out_dir / "convergence.png")
+    plots.convergence(out_dir / "convergence.png", history, ann, f"{cfg.path.stem}: convergence ({cfg.method})")
     res = obj.simulate(x)
     fs = obj.fs
     units = {c.output: obj.runner.variables[c.output].unit for c in cfg.channels}
@@ -176,16 +154,8 @@ def _figures(cfg, obj: Objective, x, history, ann, out_dir):
         if ch.bands:
             lo = min(b[0] for b in ch.bands)
             hi = max(b[1] for b in ch.bands)
-            fig, ax = plt.subplots(figsize=(7, 3.5))
-            for label, y in (("measured", meas), ("fitted model", res[ch.output])):
-                f, p = signals.welch_psd(y, fs, cfg.segment_s)
-                sel = (f >= lo) & (f <= hi)
-                ax.semilogy(f[sel], p[sel], label=label)
-            ax.set_xlabel("frequency [Hz]")
-            ax.set_ylabel(f"PSD of {ch.output} [{units[ch.output]}²/Hz]")
-            ax.legend(fontsize=8)
-            ax.set_title(f"{cfg.path.stem}: PSD in the bands")
-            plots._save(fig, out_dir / f"psd_band_{ch.output}.png")
+            plots.psd_in_bands(out_dir / f"psd_band_{ch.output}.png", [("measured", meas), ("fitted model", res[ch.output])],
+                               fs, cfg.segment_s, (lo, hi), ch.output, units, f"{cfg.path.stem}: PSD in the bands")
         plots.time_histories(out_dir / f"time_{ch.output}.png",
                              [("measured", obj.t, {ch.output: meas}), ("fitted model", res.time, {ch.output: res[ch.output]})],
                              [ch.output], units, f"{cfg.path.stem}: measured and fitted {ch.output}")

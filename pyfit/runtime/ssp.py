@@ -10,7 +10,7 @@ from xml.sax.saxutils import quoteattr
 
 from fmpy import read_model_description
 
-from .cosim import Connection
+from pyfit.runtime.cosim import Connection
 
 NS = ('xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" '
       'xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" '

@@ -22,7 +22,7 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field
+
 
 import numpy as np
 from pymoo.algorithms.soo.nonconvex.ga import GA
@@ -30,35 +30,9 @@ from pymoo.core.problem import Problem
 from pymoo.optimize import minimize
 from scipy.stats import qmc
 
-from .surrogate import Surrogate
-
-
-@dataclass
-class NNOSettings:
-    """The seed's NNO settings (Tables 4.5, 5.2, 5.7)."""
-
-    init_sim: int = 20
-    hidden_sizes: list[int] = field(default_factory=lambda: [15])
-    p_size: int = 10
-    fun_tol: float = 5e-4
-    max_sim: int = 60
-    x_tol: float = 1e-3
-    y_tol: float = 1e-3
-    ga_generations: int = 60
-    seed: int = 0
-    trust_region: bool = False
-
-
-@dataclass
-class OptimResult:
-    """Best point ever evaluated (unit-scaled), its error, the number of true evaluations and the history."""
-
-    x: np.ndarray
-    error: float
-    n_evaluations: int
-    stop_reason: str
-    history: list[dict]
-    wall_s: float
+from pyfit.fit.optim.result import OptimResult
+from pyfit.io.fit_config import NNOSettings
+from pyfit.fit.optim.surrogate import Surrogate
 
 
 class _SurrogateProblem(Problem):

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .fmu import FmuRunner, ParameterError
+from pyfit.runtime.fmu import FmuRunner, ParameterError
 
 SCHEMES = ("gauss-seidel", "jacobi")
 EXTRAPOLATIONS = ("linear", "constant")
@@ -59,7 +59,7 @@ class _Vars:
     buffers allocated once (this runs at every communication step)."""
 
     def __init__(self, runner: FmuRunner, names: list[str]):
-        self.fmu = runner._instance()
+        self.fmu = runner.instance()
         self.comp = self.fmu.component
         self.names = names
         self.n = len(names)
@@ -109,10 +109,10 @@ def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], 
 
     for name, r in runners.items():
         r.check_parameters(params.get(name, {}))
-        fmu = r._instance()
+        fmu = r.instance()
         fmu.reset()
         fmu.setupExperiment(tolerance=tolerance, startTime=0.0)
-        r._apply(fmu, params.get(name, {}))
+        r.set_parameters(fmu, params.get(name, {}))
         fmu.enterInitializationMode()
     # every output any connection or the record reads, per FMU, read in one call
     needed = [src for src, _, _ in conns] + [d for _, _, d in conns if d] + rec
@@ -130,7 +130,7 @@ def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], 
                 writes[name].set([now[s[0]][s[1]] for s, _ in inputs_of[name]])
         now = {name: reads[name].get() for name in runners}
     for name in runners:
-        runners[name]._instance().exitInitializationMode()
+        runners[name].instance().exitInitializationMode()
     now = {name: reads[name].get() for name in runners}
     prev = now
     out = np.empty((n + 1, len(rec)))
@@ -167,5 +167,5 @@ def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], 
         prev, now = now, new
         out[k + 1] = [now[f][v] for f, v in rec]
     for r in runners.values():
-        r._instance().terminate()
+        r.instance().terminate()
     return CoSimResult(np.arange(n + 1) * step, {ref: out[:, j] for j, ref in enumerate(record)})

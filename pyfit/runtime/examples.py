@@ -6,8 +6,8 @@ import pathlib
 import numpy as np
 from fmpy import read_model_description
 
-from .build import EXAMPLES, build_fmu
-from .fmu import FmuRunner
+from pyfit.build import EXAMPLES, build_fmu
+from pyfit.runtime.fmu import FmuRunner
 
 
 def ensure_fmu(name: str, fmu_dir: pathlib.Path) -> pathlib.Path:
@@ -21,9 +21,7 @@ def ensure_fmu(name: str, fmu_dir: pathlib.Path) -> pathlib.Path:
 def run_example(name: str, params: dict, stop: float | None, interval: float, fmu_dir: pathlib.Path,
                 out_dir: pathlib.Path) -> tuple[pathlib.Path, pathlib.Path]:
     """Simulate the example (co-simulation) and write <out>/<name>.csv and <out>/<name>.png."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from pyfit.analysis import plots
 
     path = ensure_fmu(name, fmu_dir)
     md = read_model_description(str(path))
@@ -40,14 +38,7 @@ def run_example(name: str, params: dict, stop: float | None, interval: float, fm
     header = ",".join(["t"] + [v.name for v in outputs])
     np.savetxt(csv, np.column_stack([res.time] + [res[v.name] for v in outputs]), delimiter=",", header=header,
                comments="")
-    fig, axes = plt.subplots(len(outputs), 1, sharex=True, figsize=(9, 1.6 * len(outputs) + 1))
-    for ax, v in zip(np.atleast_1d(axes), outputs):
-        ax.plot(res.time, res[v.name], lw=0.6)
-        ax.set_ylabel(f"{v.name} [{v.unit or '-'}]")
-    np.atleast_1d(axes)[-1].set_xlabel("time [s]")
-    fig.suptitle(f"{name}: " + ", ".join(f"{k}={v:g}" for k, v in params.items()) if params else name)
-    fig.tight_layout()
-    png = out_dir / f"{name}.png"
-    fig.savefig(png, dpi=110)
-    plt.close(fig)
+    png = plots.time_histories(out_dir / f"{name}.png", [("", res.time, res.values)], [v.name for v in outputs],
+                               {v.name: v.unit for v in outputs},
+                               f"{name}: " + ", ".join(f"{k}={v:g}" for k, v in params.items()) if params else name)
     return csv, png

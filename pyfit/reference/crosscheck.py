@@ -18,10 +18,11 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Model
 
-from . import signals
-from .excitation import Excitation, multisine
-from .fmu import FmuRunner
-from .reference import integrate, models
+from pyfit.analysis import signals
+from pyfit.analysis.excitation import Excitation, multisine
+from pyfit.runtime.fmu import FmuRunner
+from pyfit.reference import integrate
+from pyfit.reference import models
 
 # FMU variable names of the reference states x = [q, qdot, z] and of their rates [qdot, qddot, zdot]
 _TWO_DOF = (["y1", "y2", "v1", "v2", "z"], ["v1", "v2", "mass1.a", "mass2.a", "der(boucWen.z)"])
@@ -244,21 +245,10 @@ def check_trajectories(name: str, fmu: pathlib.Path, out_dir: pathlib.Path | Non
 
 
 def _overlay(path, t, want, res, outputs, name, label, units):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from pyfit.analysis import plots
 
-    fig, axes = plt.subplots(len(outputs), 1, sharex=True, figsize=(9, 1.8 * len(outputs) + 1))
-    for ax, o in zip(np.atleast_1d(axes), outputs):
-        ax.plot(t, want[o], "k", lw=1.2, label="CasADi reference (CVODES)")
-        ax.plot(t, res[o], "C1--", lw=0.8, label="FMU (co-simulation)")
-        ax.set_ylabel(f"{o} [{units.get(o) or '-'}]")
-    np.atleast_1d(axes)[0].legend(loc="upper left", fontsize=8)
-    np.atleast_1d(axes)[-1].set_xlabel("time [s]")
-    fig.suptitle(f"{name}: {label}")
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    plots.time_histories(path, [("CasADi reference (CVODES)", t, want), ("FMU (co-simulation)", t, res.values)],
+                         outputs, units, f"{name}: {label}")
 
 
 def _write_reference_csv(out_dir: pathlib.Path, name, t, want, params):

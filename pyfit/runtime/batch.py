@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .fmu import FmuRunner, SimulationResult
+from pyfit.runtime.fmu import FmuRunner, SimulationResult
 
 _RUNNERS: dict[tuple[str, str], FmuRunner] = {}  # per process
 

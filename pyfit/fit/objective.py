@@ -8,50 +8,17 @@ simulation gives a finite penalty vector and is recorded; nothing non-finite lea
 """
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import signals
-from .data import Measurement
-from .fmu import FmuRunner, SimulationResult
+from pyfit.io.fit_config import FreeParameter, ObjectiveChannel
+from pyfit.analysis import signals
+from pyfit.io.data import Measurement
+from pyfit.runtime.drive import drive
+from pyfit.runtime.fmu import FmuRunner, SimulationResult
 
 
-@dataclass
-class FreeParameter:
-    """A parameter being fitted, with its bounds in SI units."""
 
-    name: str
-    lower: float
-    upper: float
-
-    def value(self, u: float) -> float:
-        return self.lower + float(u) * (self.upper - self.lower)
-
-    def unit(self, value: float) -> float:
-        return (value - self.lower) / (self.upper - self.lower)
-
-
-@dataclass
-class ObjectiveChannel:
-    """One compared signal: FMU output, measured column, PSD bands [Hz] and weight."""
-
-    output: str
-    column: str
-    bands: list[tuple[float, float]] = field(default_factory=list)
-    weight: float = 1.0
-
-
-@dataclass
-class Evaluation:
-    """One true (FMU) evaluation."""
-
-    x: list[float]
-    error: float
-    ok: bool
-    message: str
-    wall_s: float
 
 
 class Objective:
@@ -74,14 +41,10 @@ class Objective:
         self.penalty = penalty
         self.use_inputs = use_inputs
         self.input_upsample = int(input_upsample)
-        self._inputs = self._fine_inputs(input_periodic) if use_inputs else None
-        self._input_time = (np.arange(len(next(iter(self._inputs.values())))) / (measurement.sample_rate_hz
-                                                                                  * self.input_upsample)
-                            if self._inputs else None)
+        self.input_periodic = input_periodic
         self.fs = measurement.sample_rate_hz
         self.t = measurement.t - measurement.t[0]
         self.first = int(round(warmup_s * self.fs))
-        self.evaluations: list[Evaluation] = []
         self._target = {}
         for ch in channels:
             if ch.column not in measurement.values:
@@ -110,38 +73,20 @@ class Objective:
         p.update({v.name: v.value(u) for v, u in zip(self.variables, np.clip(x, 0.0, 1.0))})
         return p
 
-    def _fine_inputs(self, periodic: bool) -> dict[str, np.ndarray]:
-        """Measured inputs on the FMU's drive grid: upsampled by input_upsample, band-limited (FFT) for
-        whole periods or by a cubic spline otherwise (linear interpolation of a 750 Hz multisine with
-        content up to 150 Hz would itself be a model error)."""
-        q = self.input_upsample
-        out = {}
-        for c, ch in self.m.inputs.items():
-            u = self.m.values[c]
-            if q == 1:
-                out[ch.model_variable] = u
-            elif periodic:
-                out[ch.model_variable] = signals.upsample_periodic(u, q)[:(len(u) - 1) * q + 1]
-            else:
-                out[ch.model_variable] = signals.upsample_spline(u, q)
-        return out
-
-    def simulate(self, x, outputs=None):
-        """The FMU's response on the measurement's time grid."""
-        q = self.input_upsample if self.use_inputs else 1
-        dt = 1.0 / (self.fs * q)
-        res = self.runner.simulate(self.t[-1], dt, outputs or [c.output for c in self.channels], self.params(x),
-                                   inputs=self._inputs, input_time=self._input_time, tolerance=self.tolerance)
-        if q > 1:
-            res = SimulationResult(res.time[::q], {k: v[::q] for k, v in res.values.items()}, res.ok, res.message)
-        return res
+    def simulate(self, x, outputs=None) -> SimulationResult:
+        """The FMU's response on the measurement's time grid (driven by the measured inputs, or by the
+        FMU's built-in excitation when use_inputs is off)."""
+        outputs = outputs or [c.output for c in self.channels]
+        if self.use_inputs:
+            return drive(self.runner, self.m.by_variable("inputs"), self.fs, outputs, self.params(x),
+                         self.input_upsample, len(self.t) if self.input_periodic else None, 0, self.tolerance)
+        return self.runner.simulate(self.t[-1], 1.0 / self.fs, outputs, self.params(x), tolerance=self.tolerance)
 
     def residuals(self, x) -> np.ndarray:
         """Residual vector (finite; the penalty vector when the simulation fails)."""
-        t0 = time.perf_counter()
         res = self.simulate(x)
         parts = []
-        ok, message = res.ok, res.message
+        ok = res.ok
         if ok:
             for ch in self.channels:
                 y = res[ch.output][self.first:]
@@ -156,12 +101,9 @@ class Objective:
                     r = (y - target) / aux
                 parts.append(np.sqrt(ch.weight) * r)
             r = np.concatenate(parts)
-            if not np.all(np.isfinite(r)):
-                ok, message = False, "non-finite residual"
+            ok = bool(np.all(np.isfinite(r)))
         if not ok:
             r = np.full(self.size, self.penalty)
-        err = float(np.sum(r**2))
-        self.evaluations.append(Evaluation([float(v) for v in x], err, ok, message, time.perf_counter() - t0))
         return r
 
     def log_ratio(self, r: np.ndarray) -> np.ndarray:

@@ -9,11 +9,12 @@ from dataclasses import dataclass
 import numpy as np
 from fmpy import read_model_description
 
-from . import plots, signals
-from .batch import RunSpec, run_batch
-from .config import SweepConfig
-from .excitation import Excitation
-from .run_example import ensure_fmu
+from pyfit.analysis import plots
+from pyfit.analysis import signals
+from pyfit.runtime.batch import RunSpec, run_batch
+from pyfit.io.sweep_config import SweepConfig
+from pyfit.analysis.excitation import Excitation
+from pyfit.runtime.examples import ensure_fmu
 
 # (force, displacement, velocity) whose loop and power characterise each model
 LOOP_SIGNALS = {"SDOFBoucWen": ("F", "y", "v"), "StockbridgeDamper": ("F_clamp", "x_clamp", "v_clamp")}

@@ -45,15 +45,6 @@ def psd_peak(y: np.ndarray, fs: float, segment_s: float | None = None) -> tuple[
     return float(f[i]), float(p[i])
 
 
-def frf_h1(u: np.ndarray, y: np.ndarray, fs: float, segment_s: float | None = None):
-    """H1 estimate of the frequency response y/u: (f [Hz], H = S_uy / S_uu, coherence)."""
-    nper = len(u) // 8 if segment_s is None else int(round(segment_s * fs))
-    f, suu = scipy.signal.welch(u, fs=fs, window="hann", nperseg=nper, detrend=False)
-    _, suy = scipy.signal.csd(u, y, fs=fs, window="hann", nperseg=nper, detrend=False)
-    _, coh = scipy.signal.coherence(u, y, fs=fs, window="hann", nperseg=nper, detrend=False)
-    return f, suy / suu, coh
-
-
 def frf_periodic(u: np.ndarray, y: np.ndarray, fs: float, period_samples: int):
     """Leakage-free FRF from whole periods of a periodic excitation (steady state): Y(f)/U(f) at excited lines.
 
@@ -70,12 +61,6 @@ def frf_periodic(u: np.ndarray, y: np.ndarray, fs: float, period_samples: int):
     lines = np.abs(U) > 1e-6 * np.max(np.abs(U))
     lines[0] = False
     return f[lines], Y[lines] / U[lines]
-
-
-def transmissibility(base: np.ndarray, response: np.ndarray, fs: float, segment_s: float | None = None):
-    """|response / base| from H1 (e.g. mass acceleration over clamp acceleration): (f, |T|)."""
-    f, h, _ = frf_h1(base, response, fs, segment_s)
-    return f, np.abs(h)
 
 
 def spectrogram(y: np.ndarray, fs: float, segment_s: float = 1.0, overlap: float = 0.75):
@@ -130,7 +115,7 @@ def steady_cycle(t, force, velocity, displacement, frequency) -> SteadyCycle:
 def sweep_power_impedance(t, force, velocity, phase, frequency, at_hz, cycles: int = 8):
     """Dissipated power [W] and impedance [N*s/m] along a slow sweep (IEC 61897 / IEEE 664 quantities).
 
-    phase(t) [rad] and frequency(t) [Hz] describe the excitation (pyfit.excitation.Excitation). Around
+    phase(t) [rad] and frequency(t) [Hz] describe the excitation (pyfit.analysis.excitation.Excitation). Around
     the time the sweep passes each frequency of at_hz, a window of `cycles` excitation periods gives
     the mean of F*v and the ratio of the fundamental amplitudes |F1|/|V1| (least squares on the
     excitation's sine and cosine). Returns two arrays aligned with at_hz (NaN where the sweep does not
@@ -167,14 +152,6 @@ def nrmse(y_ref: np.ndarray, y: np.ndarray) -> float:
 def rms_db(err: np.ndarray) -> float:
     """20*log10(RMS(err)) in dB re one unit of err."""
     return float(20 * np.log10(np.sqrt(np.mean(np.asarray(err) ** 2))))
-
-
-def band_psd_error(f: np.ndarray, psd: np.ndarray, psd_ref: np.ndarray, band: tuple[float, float]) -> np.ndarray:
-    """The seed's error vector on a band: (PSD - PSD_ref)/PSD_ref at the bins inside band [Hz]."""
-    sel = (f >= band[0]) & (f <= band[1])
-    if not sel.any():
-        raise ValueError(f"no PSD bin in band {band} Hz")
-    return (psd[sel] - psd_ref[sel]) / psd_ref[sel]
 
 
 def upsample_periodic(u: np.ndarray, factor: int) -> np.ndarray:

@@ -4,15 +4,52 @@ from __future__ import annotations
 import pathlib
 from dataclasses import dataclass, field
 
-from .build import EXAMPLES
-from .config import ConfigError, check_numbers, check_table, fail
-from .excitation import Excitation
-from .objective import FreeParameter, ObjectiveChannel
-from .optim.nno import NNOSettings
-from .synthetic import MultisineInput
-from .tomlfile import read_toml
+from pyfit.analysis.excitation import Excitation, MultisineInput
+from pyfit.build.catalog import EXAMPLES
+from pyfit.io.schema import ConfigError, check_bounds, check_numbers, check_sections, check_table, fail, read_toml
 
 METHODS = ("nno", "nno+polish", "ga", "de", "polish")
+
+
+@dataclass
+class FreeParameter:
+    """A parameter being fitted, with its bounds in SI units."""
+
+    name: str
+    lower: float
+    upper: float
+
+    def value(self, u: float) -> float:
+        return self.lower + float(u) * (self.upper - self.lower)
+
+    def unit(self, value: float) -> float:
+        return (value - self.lower) / (self.upper - self.lower)
+
+
+@dataclass
+class ObjectiveChannel:
+    """One compared signal: FMU output, measured column, PSD bands [Hz] and weight."""
+
+    output: str
+    column: str
+    bands: list[tuple[float, float]] = field(default_factory=list)
+    weight: float = 1.0
+
+
+@dataclass
+class NNOSettings:
+    """The seed's NNO settings (Tables 4.5, 5.2, 5.7)."""
+
+    init_sim: int = 20
+    hidden_sizes: list[int] = field(default_factory=lambda: [15])
+    p_size: int = 10
+    fun_tol: float = 5e-4
+    max_sim: int = 60
+    x_tol: float = 1e-3
+    y_tol: float = 1e-3
+    ga_generations: int = 60
+    seed: int = 0
+    trust_region: bool = False
 
 
 @dataclass
@@ -62,13 +99,8 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
     """Read and validate a fit study. fmu_parameters(model) -> set of settable names (to reject unknown ones)."""
     path = pathlib.Path(path)
     doc = read_toml(path, ConfigError)
-    sections = {"fit", "target", "experiment", "objective", "variables", "nno", "polish", "ga", "report"}
-    extra = set(doc) - sections
-    if extra:
-        fail(path, sorted(extra)[0], "unknown section", ", ".join(sorted(sections)))
-    for s in ("fit", "target", "objective", "variables"):
-        if s not in doc:
-            fail(path, s, "missing section")
+    check_sections(doc, path, ("fit", "target", "experiment", "objective", "variables", "nno", "polish", "ga",
+                               "report"), ("fit", "target", "objective", "variables"))
     fit = check_table(doc["fit"], path, "fit", {"model": (str, True, None), "method": (str, False, "nno"),
                                           "budget": (int, False, 60), "seed": (int, False, 0),
                                           "tolerance": (float, False, 1e-8)})
@@ -136,11 +168,7 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
         channels.append(ObjectiveChannel(c["output"], c["column"], bands, c["weight"]))
     variables = []
     for name, b in doc["variables"].items():
-        if not (isinstance(b, list) and len(b) == 2 and all(isinstance(v, (int, float)) for v in b)):
-            fail(path, f"variables.{name}", f"{b!r} is not [lower, upper]")
-        if not b[0] < b[1]:
-            fail(path, f"variables.{name}", f"inverted or empty bounds {b}", "lower < upper")
-        variables.append(FreeParameter(name, float(b[0]), float(b[1])))
+        variables.append(FreeParameter(name, *check_bounds(b, path, f"variables.{name}")))
     if not variables:
         fail(path, "variables", "no parameter to fit")
     if fmu_parameters is not None:
@@ -174,11 +202,16 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
     if nno_budget <= nn["init_sim"] and fit["method"] in ("nno", "nno+polish"):
         fail(path, "nno.init_sim", f"init_sim = {nn['init_sim']} leaves no NNO iteration within the budget "
                                     f"({nno_budget} true evaluations for NNO)")
-    settings = NNOSettings(nn["init_sim"], [int(h) for h in nn["hidden_sizes"]], nn["p_size"], nn["fun_tol"],
-                           nno_budget, nn["x_tol"], nn["y_tol"], nn["ga_generations"], fit["seed"],
-                           nn["trust_region"])
-    return FitConfig(path, fit["model"], fit["method"], fit["budget"], fit["seed"], target_file, synthetic, fixed,
-                     ob["kind"], channels, ob["segment_s"], ob["warmup_s"], ob["penalty"], fit["tolerance"],
-                     tg["use_inputs"], tg["input_upsample"], tg["input_periodic"], variables, settings, pol["kind"], pol["budget"], ga["pop_size"],
-                     check_numbers(rep["truth"], path, "report.truth"), [tuple(p) for p in rep["products"]],
-                     rep["benchmark"], nn["log_ratio"])
+    settings = NNOSettings(init_sim=nn["init_sim"], hidden_sizes=[int(h) for h in nn["hidden_sizes"]],
+                           p_size=nn["p_size"], fun_tol=nn["fun_tol"], max_sim=nno_budget, x_tol=nn["x_tol"],
+                           y_tol=nn["y_tol"], ga_generations=nn["ga_generations"], seed=fit["seed"],
+                           trust_region=nn["trust_region"])
+    return FitConfig(path=path, model=fit["model"], method=fit["method"], budget=fit["budget"], seed=fit["seed"],
+                     target_file=target_file, synthetic=synthetic, fixed=fixed, objective_kind=ob["kind"],
+                     channels=channels, segment_s=ob["segment_s"], warmup_s=ob["warmup_s"], penalty=ob["penalty"],
+                     tolerance=fit["tolerance"], use_inputs=tg["use_inputs"], input_upsample=tg["input_upsample"],
+                     input_periodic=tg["input_periodic"], variables=variables, nno=settings,
+                     polish_kinds=pol["kind"], polish_budgets=pol["budget"], ga_pop_size=ga["pop_size"],
+                     truth=check_numbers(rep["truth"], path, "report.truth"),
+                     products=[tuple(p) for p in rep["products"]], benchmark=rep["benchmark"],
+                     nno_log_ratio=nn["log_ratio"])

@@ -4,14 +4,12 @@ from __future__ import annotations
 import pathlib
 from dataclasses import dataclass, field
 
-from .build import EXAMPLES
-from .tomlfile import read_toml
+from pyfit.build.catalog import EXAMPLES
+from pyfit.io.schema import ConfigError, check_numbers, check_sections, check_table, fail, read_toml
+
+__all__ = ["ConfigError", "SweepConfig", "load_sweep"]
 
 EXCITATION_KINDS = {"sine": 1, "linear_sweep": 2, "log_sweep": 3, "cv_linear_sweep": 4, "cv_log_sweep": 5}
-
-
-class ConfigError(ValueError):
-    """A study file that cannot be used; the message names file, key and the allowed values."""
 
 
 @dataclass
@@ -55,51 +53,6 @@ class SweepConfig:
     title: str = ""
 
 
-def fail(path, key, problem, allowed=None):
-    msg = f"{path}: [{key}] {problem}"
-    if allowed is not None:
-        msg += f"; allowed: {allowed}"
-    raise ConfigError(msg)
-
-
-def check_table(table: dict, path, section: str, spec: dict):
-    """Check a TOML table against spec {key: (type, required, default)}; return the values."""
-    unknown = set(table) - set(spec)
-    if unknown:
-        fail(path, f"{section}.{sorted(unknown)[0]}", "unknown key", ", ".join(sorted(spec)))
-    out = {}
-    for key, (typ, required, default) in spec.items():
-        if key not in table:
-            if required:
-                fail(path, f"{section}.{key}", "missing")
-            out[key] = default
-            continue
-        value = table[key]
-        if typ is float and isinstance(value, int) and not isinstance(value, bool):
-            value = float(value)
-        if typ == "floats":
-            if not isinstance(value, list) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                                                      for v in value):
-                fail(path, f"{section}.{key}", f"must be a list of numbers, not {value!r}")
-            value = [float(v) for v in value]
-        elif typ == "strings":
-            if isinstance(value, str):
-                value = [value]
-            if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-                fail(path, f"{section}.{key}", f"must be a string or a list of strings, not {value!r}")
-        elif not isinstance(value, typ):
-            fail(path, f"{section}.{key}", f"must be {typ.__name__}, not {value!r}")
-        out[key] = value
-    return out
-
-
-def check_numbers(table, path, section):
-    for k, v in table.items():
-        if not isinstance(v, (int, float)) or isinstance(v, bool):
-            fail(path, f"{section}.{k}", f"must be a number, not {v!r}")
-    return {k: float(v) for k, v in table.items()}
-
-
 def load_sweep(path: str | pathlib.Path, fmu_variables=None) -> SweepConfig:
     """Read and validate a sweep study file.
 
@@ -108,13 +61,7 @@ def load_sweep(path: str | pathlib.Path, fmu_variables=None) -> SweepConfig:
     """
     path = pathlib.Path(path)
     doc = read_toml(path, ConfigError)
-    top = set(doc) - {"study", "excitation", "parameters", "parameter_sets"}
-    if top:
-        fail(path, sorted(top)[0], "unknown section", "study, excitation, parameters, parameter_sets")
-    if "study" not in doc:
-        fail(path, "study", "missing section")
-    if "excitation" not in doc:
-        fail(path, "excitation", "missing section")
+    check_sections(doc, path, ("study", "excitation", "parameters", "parameter_sets"), ("study", "excitation"))
     st = check_table(doc["study"], path, "study", {
         "models": ("strings", True, None), "stop_time": (float, True, None), "output_interval": (float, False, 1e-3),
         "outputs": ("strings", False, None), "tolerance": (float, False, 1e-8), "title": (str, False, "")})

@@ -29,9 +29,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from . import plots
-from .batch import RunSpec, run_batch
-from .span import span_properties
+from pyfit.analysis import plots
+from pyfit.runtime.batch import RunSpec, run_batch
+from pyfit.design.span import span_properties
 
 CIGRE_FNC = (-99.73, 101.62, 0.1627, 0.2256)  # W/(m·Hz³·m⁴), polynomial in Y/D, highest power first
 ETA_MAX = 1.2  # Y/D searched up to here (the CIGRE fnc turns negative above Y/D = 1.02)
@@ -202,7 +202,6 @@ def energy_balance(conductor: Conductor, table: DamperPowerTable, positions, tur
 def write_report(rows: list[BalanceRow], conductor: Conductor, table: DamperPowerTable, out_dir,
                  name: str = "energy_balance") -> pathlib.Path:
     """NAME.md (table), NAME.csv and NAME.png into out_dir; returns the md path."""
-    import matplotlib.pyplot as plt  # only when a report is written
 
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -232,15 +231,9 @@ def write_report(rows: list[BalanceRow], conductor: Conductor, table: DamperPowe
               f"of an averaging window {worst:.1e}."]
     md = out / f"{name}.md"
     md.write_text("\n".join(lines) + "\n")
-    fig, ax = plt.subplots(figsize=(7, 3.8))
     f = [r.frequency_hz for r in rows]
-    ax.semilogy(f, [r.y_without * 1e3 for r in rows], "k-", lw=2, label="no damper")
-    for x in positions:
-        ax.semilogy(f, [r.y_with[x] * 1e3 for r in rows], "o-", ms=3, label=f"damper at {x:g} m")
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel("steady antinode amplitude Y [mm]")
-    ax.legend(fontsize=8)
-    ax.set_title(f"Energy balance, {c.span_length:g} m span, ζ = {c.zeta:g}: wind input (CIGRE) = self-damping "
-                 "+ damper", fontsize=9)
-    plots._save(fig, out / f"{name}.png")
+    plots.semilogy_curves(out / f"{name}.png", [("no damper", f, [r.y_without * 1e3 for r in rows], "k-")] + [
+        (f"damper at {x:g} m", f, [r.y_with[x] * 1e3 for r in rows], "o-") for x in positions],
+        "frequency [Hz]", "steady antinode amplitude Y [mm]",
+        f"Energy balance, {c.span_length:g} m span, ζ = {c.zeta:g}: wind input (CIGRE) = self-damping + damper")
     return md

@@ -1,0 +1,267 @@
+"""Measurement files (design section 5): a CSV plus a TOML sidecar of the same stem.
+
+Sidecar keys: model, sample_rate_hz, [inputs] and [outputs] mapping column -> {unit, model_variable[, weight]};
+optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s" or "ms").
+
+The reader takes files as lab software writes them, wherever that is still unambiguous:
+- `#` comment lines before the header, quoted column names, extra columns (never parsed);
+- a time column rounded to as few as 6 significant digits, or none at all (then sample_rate_hz gives the
+  time); the samples are put on the exact grid t0 + k/fs;
+- units converted to SI on reading (see TO_SI).
+and refuses, with one error naming file, row and value, what is not: a gap, a repeated or decreasing
+time, a time column that disagrees with sample_rate_hz by more than MAX_TIME_SLIP samples, `;`
+separators or decimal commas, non-numeric or non-finite values in a used column.
+"""
+from __future__ import annotations
+
+import pathlib
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pyfit.io.schema import ConfigError, check_table, fail, read_toml
+
+TO_SI = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "rad": 1.0, "deg": np.pi / 180, "m/s": 1.0,
+         "mm/s": 1e-3, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0, "mm/s2": 1e-3, "g": 9.80665, "N": 1.0,
+         "kN": 1e3}
+TIME_UNITS = {"s": 1.0, "ms": 1e-3}
+MAX_TIME_SLIP = 0.25  # largest allowed distance [samples] of a time stamp from the uniform grid
+SIDECAR = {"model": (str, True, None), "sample_rate_hz": ("number", True, None), "inputs": (dict, False, {}),
+           "outputs": (dict, True, None), "level": (str, False, ""), "level_value": ("number", False, None),
+           "excitation": (dict, False, {}), "notes": (str, False, ""), "time_column": (str, False, "t"),
+           "time_unit": (str, False, "s")}
+
+
+class MeasurementError(ConfigError):
+    """A measurement file that cannot be used; names the file, the row or field, and what is allowed."""
+
+
+@dataclass
+class Channel:
+    """One measured column: its unit in the file, the model variable it corresponds to, its weight."""
+
+    column: str
+    unit: str
+    model_variable: str
+    weight: float = 1.0
+
+
+@dataclass
+class Measurement:
+    """Signals in SI units on a uniform grid, keyed by column name."""
+
+    path: pathlib.Path
+    model: str
+    t: np.ndarray
+    inputs: dict[str, Channel]
+    outputs: dict[str, Channel]
+    values: dict[str, np.ndarray]
+    level: str = ""
+    level_value: float | None = None
+    excitation: dict = field(default_factory=dict)
+    notes: str = ""
+
+    @property
+    def sample_rate_hz(self) -> float:
+        return 1.0 / (self.t[1] - self.t[0])
+
+    def by_variable(self, kind: str = "outputs") -> dict[str, np.ndarray]:
+        """Signals keyed by model variable name."""
+        return {ch.model_variable: self.values[c] for c, ch in getattr(self, kind).items()}
+
+
+def _channels(side, table, section) -> dict[str, Channel]:
+    out = {}
+    for col, spec in table.items():
+        c = check_table(spec, side, f"{section}.{col}", {"unit": (str, True, None), "model_variable": (str, True, None),
+                                                         "weight": ("number", False, 1.0)}, MeasurementError)
+        if c["unit"] not in TO_SI:
+            fail(side, f"{section}.{col}.unit", f"'{c['unit']}' unknown", ", ".join(TO_SI), MeasurementError)
+        if c["weight"] <= 0:
+            fail(side, f"{section}.{col}.weight", f"{c['weight']} is not > 0", error=MeasurementError)
+        out[col] = Channel(col, c["unit"], c["model_variable"], c["weight"])
+    return out
+
+
+def _header(csv_path: pathlib.Path) -> tuple[list[str], int]:
+    """Column names and the number of lines before the data (comment lines and the header)."""
+    with open(csv_path, encoding="utf-8-sig") as f:
+        for skip, line in enumerate(f, 1):
+            if line.strip() and not line.lstrip().startswith("#"):
+                break
+        else:
+            raise MeasurementError(f"{csv_path}: no header line (only comments or empty)")
+        first = next(f, "")
+    if ";" in line and "," not in line:
+        raise MeasurementError(f"{csv_path}: row {skip}: columns are separated by ';' (a decimal-comma export); "
+                               "allowed: ',' between columns and '.' as the decimal mark (export as CSV with a "
+                               "point decimal separator)")
+    names = [h.strip().strip('"').strip("'") for h in line.strip().split(",")]
+    if first.strip() and len(first.strip().split(",")) != len(names):
+        hint = " (decimal commas? use '.' as the decimal mark)" if len(first.strip().split(",")) > len(names) else ""
+        raise MeasurementError(f"{csv_path}: row {skip + 1}: {len(first.strip().split(','))} fields but "
+                               f"{len(names)} column names{hint}")
+    return names, skip
+
+
+def _load_columns(csv_path, names, skip, wanted: list[str]) -> dict[str, np.ndarray]:
+    idx = [names.index(w) for w in wanted]
+    try:
+        data = np.loadtxt(csv_path, delimiter=",", skiprows=skip, usecols=idx, ndmin=2, comments="#",
+                          encoding="utf-8-sig")
+    except ValueError as exc:
+        raise MeasurementError(f"{csv_path}: not numeric in a used column ({', '.join(wanted)}): {exc}; "
+                               "allowed: numbers with '.' as the decimal mark") from exc
+    return dict(zip(wanted, data.T))
+
+
+def check_time(t: np.ndarray, fs: float, csv_path, side, column: str, first_row: int) -> None:
+    """A time column [s] must be the uniform grid of fs within MAX_TIME_SLIP samples (rounding allowed)."""
+    if len(t) < 2:
+        raise MeasurementError(f"{csv_path}: fewer than two samples")
+    dt = np.diff(t)
+    bad = np.flatnonzero(dt <= 0)
+    if bad.size:
+        k = bad[0] + 1
+        what = "repeated" if dt[bad[0]] == 0 else "decreasing"
+        raise MeasurementError(f"{csv_path}: row {first_row + k}: {column} = {t[k]:.10g} s after {t[k - 1]:.10g} s "
+                               f"({what} time); allowed: increasing times 1/sample_rate_hz apart")
+    slip = (t - t[0]) * fs - np.arange(len(t))
+    bad = np.flatnonzero(np.abs(slip) > MAX_TIME_SLIP)
+    if bad.size:
+        k = bad[0]
+        step = dt[k - 1] * fs
+        if step > 1 + 2 * MAX_TIME_SLIP:
+            raise MeasurementError(f"{csv_path}: row {first_row + k}: {column} = {t[k]:.10g} s follows "
+                                   f"{t[k - 1]:.10g} s: a gap of {step:.3g} samples; allowed: one sample "
+                                   f"(1/{fs:g} s) between rows")
+        rate = (len(t) - 1) / (t[-1] - t[0])
+        raise MeasurementError(f"{side}: [sample_rate_hz] = {fs:g} but column '{column}' is sampled at "
+                               f"{rate:.9g} Hz (row {first_row + k}, {column} = {t[k]:.10g} s, is "
+                               f"{slip[k]:+.2f} samples off the grid; allowed: within {MAX_TIME_SLIP} samples)")
+
+
+def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
+    """Read one CSV + TOML pair (the sidecar has the same stem); validate and convert to SI."""
+    csv_path = pathlib.Path(csv_path)
+    side = csv_path.with_suffix(".toml")
+    if not csv_path.is_file():
+        raise MeasurementError(f"{csv_path}: file not found")
+    meta = check_table(read_toml(side, MeasurementError), side, "", SIDECAR, MeasurementError)
+    fs = meta["sample_rate_hz"]
+    if not fs > 0:
+        fail(side, "sample_rate_hz", f"{fs} is not > 0", error=MeasurementError)
+    if meta["time_unit"] not in TIME_UNITS:
+        fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join(TIME_UNITS), MeasurementError)
+    inputs = _channels(side, meta["inputs"], "inputs")
+    outputs = _channels(side, meta["outputs"], "outputs")
+    names, skip = _header(csv_path)
+    for name in list(inputs) + list(outputs):
+        if name not in names:
+            raise MeasurementError(f"{csv_path}: column '{name}' named in {side.name} is missing; "
+                                   f"columns: {', '.join(names)}")
+    time_col = meta["time_column"] if meta["time_column"] in names else None
+    cols = _load_columns(csv_path, names, skip, ([time_col] if time_col else []) + list({**inputs, **outputs}))
+    n = len(next(iter(cols.values())))
+    if time_col:
+        t_file = cols.pop(time_col) * TIME_UNITS[meta["time_unit"]]
+        check_time(t_file, fs, csv_path, side, time_col, skip + 1)
+        t0 = float(np.mean(t_file - np.arange(n) / fs))  # the grid that fits the rounded stamps best
+    else:
+        t0 = 0.0
+    values = {}
+    for name, ch in {**inputs, **outputs}.items():
+        v = cols[name]
+        bad = np.flatnonzero(~np.isfinite(v))
+        if bad.size:
+            raise MeasurementError(f"{csv_path}: row {skip + 1 + bad[0]}: column '{name}' is not finite "
+                                   f"({bad.size} such value(s)); allowed: finite numbers")
+        values[name] = v * TO_SI[ch.unit]
+    return Measurement(csv_path, meta["model"], t0 + np.arange(n) / fs, inputs, outputs, values, meta["level"],
+                       meta["level_value"], dict(meta["excitation"]), meta["notes"])
+
+
+def _toml_value(v) -> str:
+    """A scalar as TOML: quoted string, true/false, or number."""
+    if isinstance(v, str):
+        return f'"{v}"'
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    return f"{v}"
+
+
+def write_measurement(csv_path: str | pathlib.Path, model: str, t: np.ndarray, inputs: dict[str, tuple],
+                      outputs: dict[str, tuple], level: str = "", level_value: float | None = None,
+                      excitation: dict | None = None, notes: str = "") -> pathlib.Path:
+    """Write a CSV + TOML pair. inputs/outputs: column -> (samples in SI, unit, model_variable)."""
+    csv_path = pathlib.Path(csv_path)
+    csv_path.parent.mkdir(parents=True, exist_ok=True)
+    fs = (len(t) - 1) / (t[-1] - t[0])
+    cols = {**inputs, **outputs}
+    data = np.column_stack([t] + [np.asarray(v[0]) / TO_SI[v[1]] for v in cols.values()])
+    np.savetxt(csv_path, data, delimiter=",", header=",".join(["t"] + list(cols)), comments="",
+               fmt=["%.12g"] + ["%.10g"] * len(cols))
+
+    def table(name, d):
+        lines = [f"[{name}]"]
+        for c, (_, unit, var) in d.items():
+            lines.append(f'{c} = {{ unit = "{unit}", model_variable = "{var}" }}')
+        return lines
+
+    lines = [f'model = "{model}"', f"sample_rate_hz = {fs:.12g}"]
+    if level:
+        lines.append(f'level = "{level}"')
+    if level_value is not None:
+        lines.append(f"level_value = {level_value:.12g}")
+    if notes:
+        lines.append(f'notes = "{notes}"')
+    if inputs:
+        lines += table("inputs", inputs)
+    lines += table("outputs", outputs)
+    if excitation:
+        lines.append("[excitation]")
+        for k, v in excitation.items():
+            lines.append(f"{k} = {_toml_value(v)}")
+    csv_path.with_suffix(".toml").write_text("\n".join(lines) + "\n")
+    return csv_path
+
+
+LEVEL_KEYS = ("amplitude", "rms", "v0", "level")  # excitation keys that state a level, in this order
+
+
+def level_order(items: list[Measurement]) -> tuple[list[Measurement], str]:
+    """Measurements ordered by excitation level, and what the order rests on: 'level_value' (all sidecars
+    give it), else the sidecars' excitation amplitude (the first of LEVEL_KEYS that all give), else the
+    RMS of the first input (or, without inputs, of the first output)."""
+    if all(m.level_value is not None for m in items):
+        return sorted(items, key=lambda m: (m.level_value, m.path.name)), "level_value"
+    for key in LEVEL_KEYS:
+        vals = [m.excitation.get(key) for m in items]
+        if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
+            for m, v in zip(items, vals):
+                m.level_value = float(v)
+            return sorted(items, key=lambda m: (m.level_value, m.path.name)), f"excitation.{key}"
+    for m in items:
+        ch = next(iter(m.inputs or m.outputs))
+        m.level_value = float(np.sqrt(np.mean(m.values[ch] ** 2)))
+    return sorted(items, key=lambda m: (m.level_value, m.path.name)), "input RMS"
+
+
+def read_dataset(folder: str | pathlib.Path) -> list[Measurement]:
+    """All measurements (CSV + TOML pairs) in a folder, ordered by level (see level_order)."""
+    return read_dataset_with_order(folder)[0]
+
+
+def read_dataset_with_order(folder: str | pathlib.Path) -> tuple[list[Measurement], str]:
+    """All measurements in a folder, ordered by level, and what the order rests on."""
+    folder = pathlib.Path(folder)
+    if not folder.is_dir():
+        raise MeasurementError(f"{folder}: dataset folder not found")
+    items = [read_measurement(p) for p in sorted(folder.glob("*.csv"))]
+    if not items:
+        raise MeasurementError(f"{folder}: no measurement (CSV + TOML) found")
+    return level_order(items)
+
+
+__all__ = ["Channel", "Measurement", "MeasurementError", "TO_SI", "level_order", "read_dataset",
+           "read_dataset_with_order", "read_measurement", "write_measurement"]

@@ -1,0 +1,127 @@
+"""The measurement reader on files written the way lab software writes them (not by our writer)."""
+import numpy as np
+import pytest
+
+from pyfit.io.data import MeasurementError, read_dataset_with_order, read_measurement
+
+FS = 750.0
+N = 26251  # 35 s at 750 Hz: t = 35 s written with 6 significant digits is off by up to 5e-5 s = 0.04 sample
+
+
+def lab_file(tmp_path, name="run", time_fmt="%.6g", time=True, comments=("# bench: shaker 2", "# operator: X"),
+             extra=True, sep=",", decimal=".", t=None, sidecar_extra="", level=None, f=13.0, amp=2.0):
+    """A CSV as a test bench exports it: comment lines, quoted names, a text column, displacement in mm."""
+    t = np.arange(N) / FS if t is None else t
+    x = amp * np.sin(2 * np.pi * f * t)  # mm
+    force = 3.0 * np.cos(2 * np.pi * f * t)  # kN
+    names = (['"t"'] if time else []) + ['"x_mm"', '"F_kN"'] + (['"status"', '"T_room"'] if extra else [])
+    rows = []
+    for k in range(len(t)):
+        fields = ([time_fmt % t[k]] if time else []) + [f"{x[k]:.8f}", f"{force[k]:.8f}"]
+        if extra:
+            fields += ["OK", "21.5"]
+        rows.append(sep.join(v.replace(".", decimal) for v in fields))
+    path = tmp_path / f"{name}.csv"
+    path.write_text("\n".join(list(comments) + [sep.join(names)] + rows) + "\n")
+    side = [
+        'model = "SDOFBoucWen"', f"sample_rate_hz = {FS}", *([f"level_value = {level}"] if level is not None else []),
+        sidecar_extra,
+        "[inputs]", 'F_kN = { unit = "kN", model_variable = "u" }',
+        "[outputs]", 'x_mm = { unit = "mm", model_variable = "y" }']
+    path.with_suffix(".toml").write_text("\n".join(side) + "\n")
+    return path
+
+
+def test_rounded_time_comments_and_extra_columns_are_read(tmp_path):
+    m = read_measurement(lab_file(tmp_path))
+    t = np.arange(N) / FS
+    assert m.sample_rate_hz == pytest.approx(FS, rel=1e-12)
+    assert np.max(np.abs(m.t - t)) < 1e-9  # the exact grid, not the 6-digit stamps (off by up to 5e-5 s)
+    assert np.max(np.abs(m.values["x_mm"] - 2e-3 * np.sin(2 * np.pi * 13 * t))) < 1e-10  # mm -> m
+    assert np.max(np.abs(m.values["F_kN"] - 3e3 * np.cos(2 * np.pi * 13 * t))) < 1e-4  # kN -> N
+    assert set(m.values) == {"x_mm", "F_kN"}  # the text column and the temperature are never parsed
+
+
+def test_absent_time_column_uses_the_sidecar_rate(tmp_path):
+    m = read_measurement(lab_file(tmp_path, time=False))
+    assert m.t[0] == 0.0 and m.t[-1] == pytest.approx((N - 1) / FS, rel=1e-14)
+
+
+def test_time_in_ms_with_offset_start(tmp_path):
+    t = 12.5 + np.arange(N) / FS  # a segment cut from a long record, stamped in ms with 7 digits
+    m = read_measurement(lab_file(tmp_path, time_fmt="%.7g", t=t * 1e3, sidecar_extra='time_unit = "ms"'))
+    assert m.t[0] == pytest.approx(12.5, abs=1e-6)
+    assert np.max(np.abs(np.diff(m.t) - 1 / FS)) < 1e-12
+
+
+@pytest.mark.parametrize("case, row, words", [
+    ("gap", 1000 + 4, "gap of 2 samples"),
+    ("repeated", 500 + 4, "repeated time"),
+    ("decreasing", 700 + 4, "decreasing time"),
+])
+def test_time_errors_name_the_row(tmp_path, case, row, words):
+    t = np.arange(N) / FS
+    if case == "gap":
+        t[1000:] += 1 / FS
+    elif case == "repeated":
+        t[500] = t[499]
+    else:
+        t[700] = t[699] - 1e-3
+    with pytest.raises(MeasurementError) as err:
+        read_measurement(lab_file(tmp_path, time_fmt="%.10g", t=t))
+    msg = str(err.value)
+    assert f"row {row}" in msg and words in msg and "run.csv" in msg
+
+
+def test_rate_disagreeing_with_sidecar_by_a_fraction_of_a_sample_is_refused(tmp_path):
+    t = np.arange(N) / (FS * (1 + 2e-5))  # 0.5 sample off after 35 s
+    with pytest.raises(MeasurementError, match=r"run.toml: \[sample_rate_hz\] = 750 but column 't' is sampled at 750.01"):
+        read_measurement(lab_file(tmp_path, time_fmt="%.10g", t=t))
+
+
+def test_rate_within_rounding_is_accepted(tmp_path):
+    t = np.arange(N) / (FS * (1 + 5e-6))  # 0.13 sample after 35 s: a clock within tolerance
+    m = read_measurement(lab_file(tmp_path, time_fmt="%.10g", t=t))
+    assert m.sample_rate_hz == pytest.approx(FS, rel=1e-12)
+
+
+def test_semicolon_separator_and_decimal_comma_name_the_fix(tmp_path):
+    with pytest.raises(MeasurementError, match=r"separated by ';'.*'\.' as the decimal mark"):
+        read_measurement(lab_file(tmp_path, sep=";", decimal=","))
+    with pytest.raises(MeasurementError, match=r"row 4: 9 fields but 5 column names \(decimal commas"):
+        read_measurement(lab_file(tmp_path, decimal=",", extra=True, time_fmt="%.6f"))
+
+
+def test_missing_column_and_unknown_unit(tmp_path):
+    p = lab_file(tmp_path)
+    side = p.with_suffix(".toml")
+    side.write_text(side.read_text().replace('x_mm = { unit = "mm"', 'x_um = { unit = "mm"'))
+    with pytest.raises(MeasurementError, match=r"run.csv: column 'x_um' named in run.toml is missing; columns: t, x_mm"):
+        read_measurement(p)
+    side.write_text(side.read_text().replace('x_um = { unit = "mm"', 'x_mm = { unit = "inch"'))
+    with pytest.raises(MeasurementError, match=r"run.toml: \[outputs.x_mm.unit\] 'inch' unknown; allowed: m, mm"):
+        read_measurement(p)
+
+
+def test_levels_ordered_by_value_then_excitation_then_input_rms(tmp_path):
+    for i, (lv, amp) in enumerate([(3.0, 1.0), (1.0, 3.0), (2.0, 2.0)]):
+        d = tmp_path / "a"
+        d.mkdir(exist_ok=True)
+        lab_file(d, f"f{i}", level=lv, amp=amp)
+    items, basis = read_dataset_with_order(tmp_path / "a")
+    assert basis == "level_value" and [m.level_value for m in items] == [1.0, 2.0, 3.0]
+    d = tmp_path / "b"
+    d.mkdir()
+    for i, a in enumerate([5.0, 1.0, 3.0]):
+        lab_file(d, f"f{i}", sidecar_extra=f"[excitation]\namplitude = {a}")
+    items, basis = read_dataset_with_order(d)
+    assert basis == "excitation.amplitude" and [m.path.stem for m in items] == ["f1", "f2", "f0"]
+    d = tmp_path / "c"
+    d.mkdir()
+    for i, amp in enumerate([2.0, 1.0, 3.0]):  # input force amplitude scales with amp below
+        p = lab_file(d, f"f{i}", amp=amp)
+        text = p.read_text().split("\n")
+        p.write_text("\n".join(text[:3] + [",".join(r.split(",")[:2] + [f"{float(r.split(',')[2]) * amp:.8f}"]
+                                                    + r.split(",")[3:]) for r in text[3:] if r] ) + "\n")
+    items, basis = read_dataset_with_order(d)
+    assert basis == "input RMS" and [m.path.stem for m in items] == ["f1", "f0", "f2"]
