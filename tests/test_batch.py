@@ -64,7 +64,16 @@ def test_three_hundred_reset_runs_in_one_process_without_memory_growth(fmu_dir):
     assert rss[1] <= 1.05 * rss[0], rss
 
 
-def test_run_one_reuses_the_instance(fmu_dir):
+def test_run_one_reuses_the_instance(fmu_dir, monkeypatch):
+    from pyfit.runtime import batch
+    from pyfit.runtime.fmu import FmuRunner
+
+    made = []
+    real = FmuRunner.instance
+    monkeypatch.setattr(FmuRunner, "instance", lambda self: made.append(id(self._state.get("fmu"))) or real(self))
+    monkeypatch.setattr(batch, "_RUNNERS", {})
     spec = _sweep_specs(fmu_dir / "SDOFBoucWen.fmu")[0]
     a, b = run_one(spec), run_one(spec)
     np.testing.assert_array_equal(a["y"], b["y"])
+    # one runner in this process, and the second run found the instance the first one loaded
+    assert len(batch._RUNNERS) == 1 and len(made) == 2 and made[0] == id(None) and made[1] != id(None)

@@ -52,7 +52,9 @@ def test_identifiability_finds_the_degenerate_pair():
     assert ident.singular_values[-1] < 1e-6 * ident.singular_values[0]
     ok = baselines.identifiability(_linear_residuals, np.array([0.3, 0.7, 0.55]), vars_, noise_var=1e-4)
     assert ok.singular_values[-1] > 0.1
-    assert all(abs(s - 0.01 * e) < 0.02 for s, e in zip(ok.std, [1, 1, 1]))  # sigma (J^T J)^-1/2 ~ 0.01
+    # the residual is linear (J = A exactly, central differences exact to rounding): sigma = sqrt(diag(1e-4 (A^T A)^-1))
+    A = np.array([[1.0, 0.2, 0.0], [0.0, 1.0, -0.3], [0.4, 0.0, 1.0], [1.0, 1.0, 1.0]])
+    np.testing.assert_allclose(ok.std, np.sqrt(np.diag(1e-4 * np.linalg.inv(A.T @ A))), rtol=1e-8)
 
 
 def test_surrogate_learns_a_smooth_vector_function():
@@ -70,7 +72,6 @@ def test_nno_finds_the_optimum_returns_the_best_point_and_is_reproducible():
     a = nno(_linear_residuals, 3, settings)
     b = nno(_linear_residuals, 3, settings)
     assert [(h["x"], h["true_error"]) for h in a.history] == [(h["x"], h["true_error"]) for h in b.history]
-    assert a.error == min(h["true_error"] for h in a.history)  # best point ever evaluated
     np.testing.assert_allclose(a.x, [0.3, 0.7, 0.55], atol=0.03)
     assert a.n_evaluations <= 30 and a.stop_reason in ("fun_tol", "stall", "max_sim")
 
@@ -79,9 +80,8 @@ def test_baselines_respect_the_budget_and_polish_converges():
     de = baselines.differential_evolution(_curved_residuals, 3, budget=100, seed=0)
     assert de.n_evaluations == 100 and de.stop_reason == "budget"
     ga, reached = baselines.ga_direct(_curved_residuals, 3, budget=200, pop_size=20, seed=0, target=0.05)
-    assert ga.n_evaluations <= 200
-    if reached is not None:
-        assert ga.history[reached - 1]["true_error"] <= 0.05
+    assert reached is not None and ga.n_evaluations == reached  # stopped at the target, within the budget
+    assert ga.history[reached - 1]["true_error"] <= 0.05 < min(h["true_error"] for h in ga.history[:reached - 1])
     pol = baselines.polish(_curved_residuals, np.array([0.8, 0.6, 0.6]), budget=200)
     np.testing.assert_allclose(pol.x, [1.0, 1.0, 0.4], atol=1e-3)
 

@@ -18,7 +18,6 @@ def test_sdof_linear_limit_natural_frequency_and_damping(runner):
     m, c, k, alpha = 2.0, 10.0, 5e4, 5e4
     f0 = np.sqrt((k + alpha) / m) / (2 * np.pi)  # 35.59 Hz, seed Table 4.2
     zeta = c / (2 * np.sqrt((k + alpha) * m))  # 1.12 %
-    assert f0 == pytest.approx(35.59, abs=0.01) and zeta == pytest.approx(0.0112, abs=1e-4)
     assert mode.f_n == pytest.approx(f0, rel=0.005)
     assert mode.zeta == pytest.approx(zeta, rel=0.05)
 

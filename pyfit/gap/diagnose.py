@@ -13,14 +13,14 @@ from pyfit.runtime.batch import map_tasks
 from pyfit.io.data import MeasurementError, read_dataset
 from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.examples import ensure_fmu
-from pyfit.io.schema import read_toml
+from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read_toml
 from pyfit.gap import localise
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import Fit, effect_task, nominal_task, run_fit, screen
 from pyfit.gap.systems import get_system
 
 
-class DiagnoseError(ValueError):
+class DiagnoseError(ConfigError):
     """Bad input to a diagnosis; names the file and field and what is allowed."""
 
 
@@ -40,29 +40,20 @@ class DiagnoseConfig:
     min_shrink_pct: float = 50.0  # the best effect must shrink the gap by this much to be chosen
 
 
-_TYPES = {"effects": (list,), "calibration": (list,), "bands_hz": (list,), "nominal_budget": (int,),
-          "refit_budget": (int,), "upsample": (int,)}  # the others: int or float
+_SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
+                   int if f.name in ("nominal_budget", "refit_budget", "upsample") else "number"), False, f.default)
+         for f in fields(DiagnoseConfig)}
 
 
 def load_config(path) -> DiagnoseConfig:
     """A DiagnoseConfig from the [diagnose] table of a TOML file; one clear error per problem."""
     path = pathlib.Path(path)
     raw = read_toml(path, DiagnoseError)
-    if set(raw) - {"diagnose"}:
-        raise DiagnoseError(f"{path}: [{sorted(set(raw) - {'diagnose'})[0]}] unknown table; allowed: [diagnose]")
-    table = raw.get("diagnose", {})
-    allowed = {f.name for f in fields(DiagnoseConfig)}
-    for key, value in table.items():
-        if key not in allowed:
-            raise DiagnoseError(f"{path}: [diagnose] {key}: unknown key; allowed: {', '.join(sorted(allowed))}")
-        want = _TYPES.get(key, (int, float))
-        if not isinstance(value, want) or isinstance(value, bool):
-            raise DiagnoseError(f"{path}: [diagnose] {key} = {value!r}: expected "
-                                f"{' or '.join(w.__name__ for w in want)}")
-    cfg = DiagnoseConfig(**table)
+    check_sections(raw, path, ("diagnose",), error=DiagnoseError)
+    cfg = DiagnoseConfig(**check_table(raw.get("diagnose", {}), path, "diagnose", _SPEC, DiagnoseError))
     for lo_hi in cfg.bands_hz or []:
         if not (isinstance(lo_hi, list) and len(lo_hi) == 2 and 0 <= lo_hi[0] < lo_hi[1]):
-            raise DiagnoseError(f"{path}: [diagnose] bands_hz: {lo_hi!r} is not [lo, hi] with 0 <= lo < hi")
+            fail(path, "diagnose.bands_hz", f"{lo_hi!r} is not [lo, hi]", "0 <= lo < hi [Hz]", DiagnoseError)
     return cfg
 
 

@@ -1,5 +1,6 @@
 within StockbridgeDamper.Elements;
 model ConductorSpan "Laboratory conductor span: taut string between rigid ends, modal model (sine modes, every mode below 60 Hz for the default Drake ACSR span), a built-in shaker force at x_e and a damper clamp at x_d: clamp force in; clamp motion out"
+  extends Interfaces.PartialBuiltInExcitation(exc_type=1, exc_amplitude(unit="N")=5, exc_f_start=10, exc_f_end=50);
   constant Integer N = 27 "Number of modes kept (27 x 2.18 Hz = 59 Hz for the default span)";
   parameter Real L(unit="m", min=0) = 30 "Span length";
   parameter Real T(unit="N", min=0) = 28000 "Conductor tension (about 20 % of the rated tensile strength of ACSR Drake, 140 kN)";
@@ -8,13 +9,6 @@ model ConductorSpan "Laboratory conductor span: taut string between rigid ends, 
   parameter Real x_d(unit="m", min=0) = 1.0 "Damper clamp position from the span end";
   parameter Real m_c(unit="kg", min=0) = 0.6 "Damper clamp mass, carried by the span at x_d (set the damper FMU's m_c to 0)";
   parameter Real x_e(unit="m", min=0) = 14.1 "Shaker force position from the span end";
-  parameter Integer exc_type(min=0, max=3) = 1 "Built-in shaker force: 0 off, 1 sine, 2 linear sweep, 3 log sweep";
-  parameter Real exc_amplitude(unit="N") = 5 "Shaker force amplitude";
-  parameter Real exc_f_start(unit="Hz", min=0) = 10 "Sine frequency or sweep start frequency";
-  parameter Real exc_f_end(unit="Hz", min=0) = 50 "Sweep end frequency";
-  parameter Real exc_rate(unit="Hz/s", min=0) = 0.5 "Linear sweep rate";
-  parameter Real exc_octaves_per_minute(unit="1/min") = 1 "Logarithmic sweep rate";
-  parameter Real exc_t_ramp(unit="s", min=0) = 0 "Smooth amplitude ramp-in time";
   input Real F_clamp(unit="N", start=0) "Force the span applies to the damper clamp, upward (the damper FMU's F_clamp); the span feels -F_clamp";
   output Real y_d(unit="m") "Span displacement at the damper clamp";
   output Real v_d(unit="m/s") "Span velocity at the damper clamp";
@@ -39,8 +33,6 @@ model ConductorSpan "Laboratory conductor span: taut string between rigid ends, 
   Real vd_n[N](each unit="m/s") "Modal contributions to v_d";
   Real ye_n[N](each unit="m") "Modal contributions to y_e";
   Real ve_n[N](each unit="m/s") "Modal contributions to the velocity at the shaker";
-  Sources.Excitation excitation(kind=exc_type, amplitude=exc_amplitude, f_start=exc_f_start, f_end=exc_f_end,
-    rate=exc_rate, octaves_per_minute=exc_octaves_per_minute, t_ramp=exc_t_ramp) "Built-in shaker force signal";
 equation
   M = m_l*L/2;
   F_e = excitation.y;

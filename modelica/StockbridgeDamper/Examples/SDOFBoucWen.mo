@@ -1,5 +1,6 @@
 within StockbridgeDamper.Examples;
 model SDOFBoucWen "Bouc-Wen benchmark oscillator (Noel-Schoukens): m*y'' + c*y' + k*y + z = u, with optional candidate effects"
+  extends Interfaces.PartialBuiltInExcitation(exc_type=2, exc_amplitude(unit="N")=120);
   parameter Real m(unit="kg", min=0) = 2 "Mass";
   parameter Real c(unit="N.s/m", min=0) = 10 "Viscous damping coefficient";
   parameter Real k(unit="N/m") = 5e4 "Linear stiffness";
@@ -12,13 +13,6 @@ model SDOFBoucWen "Bouc-Wen benchmark oscillator (Noel-Schoukens): m*y'' + c*y' 
   parameter Real F_c(unit="N") = 0 "Coulomb friction force (candidate effect coulomb_friction; 0 = absent)";
   parameter Real v_s(unit="m/s", min=0) = 1e-3 "Regularisation velocity of the friction tanh";
   parameter Real c2(unit="N.s2/m2") = 0 "Quadratic damping coefficient (candidate effect quadratic_damping; 0 = absent)";
-  parameter Integer exc_type(min=0, max=3) = 2 "Built-in force: 0 off, 1 sine, 2 linear sweep, 3 log sweep; added to the input u";
-  parameter Real exc_amplitude(unit="N") = 120 "Amplitude of the built-in force";
-  parameter Real exc_f_start(unit="Hz", min=0) = 0 "Sine frequency or sweep start frequency";
-  parameter Real exc_f_end(unit="Hz", min=0) = 60 "Sweep end frequency (held afterwards)";
-  parameter Real exc_rate(unit="Hz/s", min=0) = 0.5 "Linear sweep rate";
-  parameter Real exc_octaves_per_minute(unit="1/min") = 1 "Logarithmic sweep rate";
-  parameter Real exc_t_ramp(unit="s", min=0) = 0 "Smooth amplitude ramp-in time (0: none)";
   input Real u(unit="N", start=0) "External force on the mass (added to the built-in excitation)";
   output Real y(unit="m") "Displacement of the mass";
   output Real v(unit="m/s") "Velocity of the mass";
@@ -32,8 +26,6 @@ model SDOFBoucWen "Bouc-Wen benchmark oscillator (Noel-Schoukens): m*y'' + c*y' 
   Components.QuadraticDamper quadraticDamper(c2=c2) "Quadratic damping to ground";
   Components.Fixed fixed "Ground";
   Sources.Force force "Force on the mass";
-  Sources.Excitation excitation(kind=exc_type, amplitude=exc_amplitude, f_start=exc_f_start, f_end=exc_f_end,
-    rate=exc_rate, octaves_per_minute=exc_octaves_per_minute, t_ramp=exc_t_ramp) "Built-in force signal";
 equation
   force.u = u + excitation.y;
   connect(force.flange, mass.flange);

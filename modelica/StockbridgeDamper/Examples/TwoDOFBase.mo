@@ -1,5 +1,6 @@
 within StockbridgeDamper.Examples;
 partial model TwoDOFBase "Two-degree-of-freedom system (seed Tables 4.3/4.4): masses, springs, dampers and the force on mass 1"
+  extends Interfaces.PartialBuiltInExcitation(exc_type=2, exc_amplitude(unit="N")=10);
   parameter Real m1(unit="kg", min=0) = 0.5 "Mass 1 (driven)";
   parameter Real m2(unit="kg", min=0) = 1 "Mass 2";
   parameter Real k1(unit="N/m") = 2000 "Spring mass 1 - ground";
@@ -13,13 +14,6 @@ partial model TwoDOFBase "Two-degree-of-freedom system (seed Tables 4.3/4.4): ma
   parameter Real gamma = 0.8 "Bouc-Wen shape parameter";
   parameter Real delta = -1.1 "Bouc-Wen shape parameter";
   parameter Real nu(min=1) = 2 "Bouc-Wen exponent";
-  parameter Integer exc_type(min=0, max=3) = 2 "Built-in force on mass 1: 0 off, 1 sine, 2 linear sweep, 3 log sweep; added to the input f";
-  parameter Real exc_amplitude(unit="N") = 10 "Amplitude of the built-in force";
-  parameter Real exc_f_start(unit="Hz", min=0) = 0 "Sine frequency or sweep start frequency";
-  parameter Real exc_f_end(unit="Hz", min=0) = 60 "Sweep end frequency (held afterwards)";
-  parameter Real exc_rate(unit="Hz/s", min=0) = 0.5 "Linear sweep rate";
-  parameter Real exc_octaves_per_minute(unit="1/min") = 1 "Logarithmic sweep rate";
-  parameter Real exc_t_ramp(unit="s", min=0) = 0 "Smooth amplitude ramp-in time (0: none)";
   input Real f(unit="N", start=0) "External force on mass 1 (added to the built-in excitation)";
   output Real y1(unit="m") "Displacement of mass 1";
   output Real y2(unit="m") "Displacement of mass 2";
@@ -35,8 +29,6 @@ partial model TwoDOFBase "Two-degree-of-freedom system (seed Tables 4.3/4.4): ma
   Components.BoucWen boucWen(alpha=alpha, beta=beta, gamma=gamma, delta=delta, nu=nu) "Hysteretic element";
   Components.Fixed fixed "Ground";
   Sources.Force force "Force on mass 1";
-  Sources.Excitation excitation(kind=exc_type, amplitude=exc_amplitude, f_start=exc_f_start, f_end=exc_f_end,
-    rate=exc_rate, octaves_per_minute=exc_octaves_per_minute, t_ramp=exc_t_ramp) "Built-in force signal";
 equation
   force.u = f + excitation.y;
   connect(force.flange, mass1.flange);

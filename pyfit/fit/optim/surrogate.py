@@ -9,6 +9,17 @@ import numpy as np
 import torch
 
 
+class _deterministic:
+    """Context: torch's deterministic algorithms on, restored afterwards."""
+
+    def __enter__(self):
+        self.was = torch.are_deterministic_algorithms_enabled()
+        torch.use_deterministic_algorithms(True)
+
+    def __exit__(self, *exc):
+        torch.use_deterministic_algorithms(self.was)
+
+
 class Surrogate:
     """MLP residual model; `predict` evaluates a whole population in one batched forward pass."""
 
@@ -33,7 +44,20 @@ class Surrogate:
         return torch.nn.Sequential(*layers).double()
 
     def fit(self, X: np.ndarray, R: np.ndarray) -> "Surrogate":
-        """Train on parameters X (n, d) in [0, 1] and residual vectors R (n, m)."""
+        """Train on parameters X (n, d) in [0, 1] and residual vectors R (n, m).
+
+        Deterministic: seeded, one thread (the order of floating-point sums must not depend on the core
+        count), deterministic kernels only; the same X, R and seed give the same network on any machine
+        with the same torch build."""
+        threads = torch.get_num_threads()
+        torch.set_num_threads(1)
+        try:
+            with _deterministic():
+                return self._fit(X, R)
+        finally:
+            torch.set_num_threads(threads)
+
+    def _fit(self, X: np.ndarray, R: np.ndarray) -> "Surrogate":
         torch.manual_seed(self.seed)
         rng = np.random.default_rng(self.seed)
         X = np.asarray(X, float)
