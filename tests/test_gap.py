@@ -26,6 +26,15 @@ def _case(root, effect, seed=0):
     return path
 
 
+def _diagnosed(root, fmu_dir, effect):
+    """The output folder of a finished diagnosis of that case (run here unless a test above ran it: the
+    stored fits make the second call a resume)."""
+    out = root / f"out_{effect}"
+    if not (out / "report.json").is_file():
+        dg.diagnose("sdof", _case(root, effect), out, CI, fmu_dir, workers=2, progress=False)
+    return out
+
+
 @pytest.mark.parametrize("effect", ["hysteresis", "cubic_stiffness", "coulomb_friction", "quadratic_damping"])
 def test_withheld_effect_is_found_where_it_acts_and_removes_the_gap(data_root, fmu_dir, effect):
     data = _case(data_root, effect)
@@ -50,9 +59,7 @@ def test_null_dataset_gives_no_false_alarm(data_root, fmu_dir, seed):
 
 
 def test_interrupted_diagnosis_resumes_from_finished_refits(data_root, fmu_dir, monkeypatch):
-    out = data_root / "out_quadratic_damping"
-    if not (out / "report.json").is_file():
-        pytest.skip("needs the quadratic_damping case above")
+    out = _diagnosed(data_root, fmu_dir, "quadratic_damping")
     before = json.loads((out / "report.json").read_text())
     (out / "fits" / "cubic_stiffness.json").unlink()  # as if killed while that refit ran
     calls = []
@@ -99,9 +106,7 @@ def test_bad_input_gives_one_clear_error(data_root, tmp_path, fmu_dir):
 
 def test_close_runner_up_gets_a_level_and_band_to_measure(data_root, fmu_dir):
     # reuse the stored refits of the quadratic-damping case; call every runner-up close (close_points 100)
-    out = data_root / "out_quadratic_damping"
-    if not (out / "report.json").is_file():
-        pytest.skip("needs the quadratic_damping case above")
+    out = _diagnosed(data_root, fmu_dir, "quadratic_damping")
     cfg = dg.DiagnoseConfig(nominal_budget=30, refit_budget=60, close_points=100.0)
     rep = dg.diagnose("sdof", _case(data_root, "quadratic_damping"), out, cfg, fmu_dir, workers=1, progress=False)
     sep = rep["separation"]
