@@ -12,6 +12,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from pyfit.runtime.batch import RunSpec, run_batch  # noqa: E402
 from pyfit.build import EXAMPLES, build_fmu  # noqa: E402
+from pyfit.report.readme import BenchReport  # noqa: E402
 
 
 def main():
@@ -30,7 +31,7 @@ def main():
             times[workers] = time.perf_counter() - t0
             assert all(r.ok for r in res)
     speedup = times[1] / times[2]
-    print(f"{args.runs} SDOF runs (20 s sweeps): 1 worker {times[1]:.2f} s, 2 workers {times[2]:.2f} s, "
+    BenchReport("batch_speedup", pathlib.Path(__file__).resolve().parents[1]).line(f"{args.runs} SDOF runs (20 s sweeps): 1 worker {times[1]:.2f} s, 2 workers {times[2]:.2f} s, "
           f"speed-up {speedup:.2f}x (goal >= 1.8x: {'met' if speedup >= 1.8 else 'NOT met'})")
 
 

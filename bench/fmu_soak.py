@@ -14,6 +14,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from pyfit.build import EXAMPLES, build_fmu  # noqa: E402
 from pyfit.runtime.fmu import FmuRunner  # noqa: E402
+from pyfit.report.readme import BenchReport  # noqa: E402
 
 
 def rss_mib() -> float:
@@ -40,7 +41,7 @@ def main():
         rss_end = rss_mib()
         runner.close()
     growth = (rss_end - rss100) / rss100 * 100
-    print(f"{args.runs} runs of {args.model} in one process: {time.perf_counter() - t0:.1f} s, no crash; "
+    BenchReport("fmu_soak", pathlib.Path(__file__).resolve().parents[1]).line(f"{args.runs} runs of {args.model} in one process: {time.perf_counter() - t0:.1f} s, no crash; "
           f"RSS after 100 runs {rss100:.1f} MiB, after {args.runs} {rss_end:.1f} MiB, growth {growth:+.2f} % "
           f"(goal <= 5 %: {'met' if growth <= 5 else 'NOT met'})")
 

@@ -24,6 +24,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 from pyfit.io import benchmark_data as bd  # noqa: E402
 from pyfit.build import EXAMPLES, build_fmu  # noqa: E402
 from pyfit.runtime.fmu import FmuRunner  # noqa: E402
+from pyfit.report.readme import BenchReport  # noqa: E402
 
 M, C, K, ALPHA, BETA, GAMMA, DELTA, NU = 2.0, 10.0, 5e4, 5e4, 1e3, 0.8, -1.1, 1.0
 
@@ -81,6 +82,7 @@ def main():
         }
         runner.close()
     y_ref = scipy_run(u, fs, 1e-13)
+    report = BenchReport("sdof_eval", pathlib.Path(__file__).resolve().parents[1])
     for label, (t_fmu, y_fmu) in fmu_runs.items():
         err_fmu = bd.rms_db(y_fmu - y_ref)
         for rtol in (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11):
@@ -88,9 +90,9 @@ def main():
             err_sp = bd.rms_db(y_sp - y_ref)
             if err_sp <= err_fmu:
                 break
-        print(f"FMU via fmpy ({label}): {t_fmu:.3f} s per evaluation, error {err_fmu:.1f} dB re tight reference "
+        report.line(f"FMU via fmpy ({label}): {t_fmu:.3f} s per evaluation, error {err_fmu:.1f} dB re tight reference "
               f"(goal <= 0.5 s: {'met' if t_fmu <= 0.5 else 'NOT met'})")
-        print(f"  solve_ivp DOP853 at equal or better accuracy (rtol={rtol:g}, {err_sp:.1f} dB): {t_sp:.3f} s; "
+        report.line(f"solve_ivp DOP853 at equal or better accuracy (rtol={rtol:g}, {err_sp:.1f} dB): {t_sp:.3f} s; "
               f"ratio FMU / solve_ivp = {t_fmu / t_sp:.3f}")
 
 

@@ -12,9 +12,8 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from pyfit.io.sweep_config import ConfigError  # noqa: E402
-from pyfit.io.data import MeasurementError  # noqa: E402
-from pyfit.fit.batch import fit_batch  # noqa: E402
+from pyfit.io.schema import ConfigError  # noqa: E402
+from pyfit.fit.batch import describe_run, fit_batch  # noqa: E402
 
 DEFAULT = pathlib.Path(__file__).resolve().parents[1] / "configs" / "quickstart.toml"
 
@@ -32,12 +31,12 @@ def main() -> int:
     try:
         results = fit_batch(configs, args.repeats, pathlib.Path(args.out), pathlib.Path(args.fmus), args.workers,
                             args.scheduler)
-    except (ConfigError, MeasurementError, FileNotFoundError) as exc:
+    except (ConfigError, FileNotFoundError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     failed = [r for r in results if "error" in r]
-    for r in failed:
-        print(f"fit {pathlib.Path(r['config']).stem} seed {r['seed']} failed: {r['error']}", file=sys.stderr)
+    for r in results:
+        print(describe_run(r), file=sys.stderr if "error" in r else sys.stdout)
     print(f"{len(results) - len(failed)} of {len(results)} fits done; summary: {args.out}/summary.md")
     return 1 if failed else 0
 

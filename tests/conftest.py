@@ -31,3 +31,42 @@ def runner(fmu_dir):
     yield get
     for r in cache.values():
         r.close()
+
+
+# ---- figures the tests measure, for the README's generated table ------------------------------------------
+_MEASURED: list[dict] = []
+MEASURED_TABLE = ROOT / "results" / "tests.md"
+
+
+@pytest.fixture
+def measured(request):
+    """measured(check, value, bar, at_least=False): assert value <= bar (>= with at_least) and record the
+    figure, so that a full test run writes results/tests.md (what was checked, measured, allowed)."""
+
+    def record(check: str, value: float, bar: float, at_least: bool = False) -> float:
+        value = float(value)
+        ok = value >= bar if at_least else value <= bar
+        assert ok, f"{check}: measured {value:.4g}, {'at least' if at_least else 'at most'} {bar:.4g} allowed"
+        _MEASURED.append({"test": request.node.nodeid, "check": check, "value": value, "bar": bar,
+                          "at_least": at_least})
+        return value
+
+    return record
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.3g}" if x != 0 else "0"
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """Write the measured figures of this run (only after a run where every test passed)."""
+    if not _MEASURED or exitstatus != 0:
+        return
+    lines = ["| check | measured | allowed | test |", "|---|---|---|---|"]
+    for m in _MEASURED:
+        test = m["test"].split("::", 1)
+        check = m["check"].replace("|", "\\|")
+        lines.append(f"| {check} | {_fmt(m['value'])} | {'≥' if m['at_least'] else '≤'} {_fmt(m['bar'])} | "
+                     f"`{test[0].removeprefix('tests/')}::{test[1]}` |")
+    MEASURED_TABLE.parent.mkdir(parents=True, exist_ok=True)
+    MEASURED_TABLE.write_text("\n".join(lines) + "\n")

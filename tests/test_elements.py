@@ -9,8 +9,8 @@ import scipy.integrate
 from fmpy.validation import validate_fmu
 
 from pyfit.build import EXAMPLES
-from pyfit.analysis.excitation import Excitation
-from pyfit.build.element_docs import REFERENCE_RUNS, motion_with_derivatives, write_docs
+from pyfit.analysis.excitation import Excitation, motion_with_derivatives
+from pyfit.build.element_docs import REFERENCE_RUNS, write_docs
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
@@ -80,10 +80,19 @@ def test_damper_element_driven_by_clamp_motion_equals_the_damper_with_its_built_
 FMI_SIM = shutil.which("fmi-sim")
 
 
+# outputs with direct feedthrough of an input (the others are functions of the state alone)
+FEEDTHROUGH = {"BoucWenElement": {"df"}, "BoucWenNormalizedElement": {"f", "df"}, "CubicSpringElement": {"f"},
+               "DamperElement": {"F_clamp"}}
+
+
 @pytest.mark.skipif(FMI_SIM is None, reason="fmi-sim not installed: cargo install fmi-sim@0.7.0 --locked")
 @pytest.mark.parametrize("name", list(REFERENCE_RUNS))
-def test_element_fmus_run_in_the_second_importer(fmu_dir, runner, tmp_path, name):
-    """Every element FMU runs in fmi-sim (co-simulation, inputs from a CSV) and agrees with pyfit's run."""
+def test_element_fmus_run_in_the_second_importer(fmu_dir, runner, tmp_path, name, measured):
+    """Every element FMU runs in fmi-sim (co-simulation, inputs from a CSV) and agrees with pyfit's run.
+
+    fmi-sim holds each input over a step (no input derivatives) and records the outputs at t_k before it sets
+    the input of t_k: pyfit with held inputs reproduces its states exactly, and a pure function of the input
+    (the cubic spring) one sample later. Outputs that mix state and input are not compared here."""
     _, make_inputs, params, outputs = REFERENCE_RUNS[name]
     t = np.arange(int(round(STOP / DT)) + 1) * DT
     u = make_inputs(t) if make_inputs else {}
@@ -96,21 +105,82 @@ def test_element_fmus_run_in_the_second_importer(fmu_dir, runner, tmp_path, name
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     other = np.genfromtxt(tmp_path / "out.csv", delimiter=",", names=True)
-    ours = runner(name).simulate(STOP, DT, outputs[:1], params, inputs=u or None, input_time=t if u else None)
-    n = min(len(other), len(t))
-    o = outputs[0]
-    # fmi-sim holds the inputs over each 1e-4 s step (no input derivatives): differences O(w dt) ~ 1e-2 (2.5 %
-    # for the damper's F_clamp, which feeds the held clamp acceleration straight through)
-    assert np.max(np.abs(other[o][:n] - ours[o][:n])) <= 3e-2 * np.max(np.abs(ours[o]))
+    assert len(other) == len(t)
+    ours = runner(name).simulate(STOP, DT, outputs, params, inputs=u or None, input_time=t if u else None,
+                                 hold_inputs=True)
+    compared = [o for o in outputs if o not in FEEDTHROUGH.get(name, set())]
+    if compared:
+        worst = max(np.max(np.abs(other[o] - ours[o])) / np.max(np.abs(ours[o])) for o in compared)
+        measured(f"{name} in fmi-sim 0.7 (held inputs) vs pyfit with held inputs: max|Δ|/max over "
+                 f"{', '.join(compared)}", worst, 1e-12)
+    else:  # the output is a function of the input alone: fmi-sim's sample k is pyfit's sample k - 1
+        o = outputs[0]
+        measured(f"{name} in fmi-sim 0.7 vs pyfit, {o} one sample later: max|Δ|/max",
+                 np.max(np.abs(other[o][1:] - ours[o][:-1])) / np.max(np.abs(ours[o])), 1e-12)
 
 
-@pytest.mark.parametrize("name", list(REFERENCE_RUNS))
-def test_committed_reference_results_are_reproduced(fmu_dir, tmp_path, name):
-    """docs/fmus/<name>/<name>_ref.csv (for users of other tools) still matches the FMU built from modelica/."""
-    committed = np.genfromtxt(ROOT / "docs" / "fmus" / name / f"{name}_ref.csv", delimiter=",", names=True)
-    fresh_dir = write_docs(name, fmu_dir / f"{name}.fmu", tmp_path)
-    fresh = np.genfromtxt(fresh_dir / f"{name}_ref.csv", delimiter=",", names=True)
+def _committed(name):
+    return np.genfromtxt(ROOT / "docs" / "fmus" / name / f"{name}_ref.csv", delimiter=",", names=True)
+
+
+def _bouc_wen_along(csv, rate, force):
+    """Independent integration (scipy DOP853) of dz/dt = rate(v, z) along the CSV's inputs s and v, which the
+    reference run applied linearly between their samples; the force from s and z."""
+    t, s_in, v_in = csv["time"], csv["s"], csv["v"]
+    z = [0.0]
+    for k in range(len(t) - 1):
+        v0, dv = v_in[k], (v_in[k + 1] - v_in[k]) / (t[k + 1] - t[k])
+        sol = scipy.integrate.solve_ivp(lambda tt, zz: [rate(v0 + dv * (tt - t[k]), zz[0])], (t[k], t[k + 1]),
+                                        [z[-1]], rtol=1e-12, atol=1e-15, method="DOP853")
+        z.append(sol.y[0, -1])
+    return force(s_in, np.array(z))
+
+
+def _independent(name, csv):
+    """The committed reference run recomputed without the FMU: name -> {output: samples}."""
+    from pyfit.reference import integrate, models
+
+    t = csv["time"]
+    if name == "BoucWenElement":
+        al, be, ga, de = 5e4, 1e3, 0.8, -1.1
+        return {"f": _bouc_wen_along(csv, lambda v, z: al * v - be * (ga * abs(v) * z + de * v * abs(z)),
+                                     lambda s, z: -z)}
+    if name == "BoucWenNormalizedElement":
+        k, a, A_, be, ga, D = 300.0, 0.3, 1.0, 0.6, 0.4, 1e-3
+        return {"f": _bouc_wen_along(csv, lambda v, z: (A_ * v - be * abs(v) * z - ga * v * abs(z)) / D,
+                                     lambda s, z: -k * (a * s + (1 - a) * D * z))}
+    if name == "CubicSpringElement":
+        return {"f": -1e6 * csv["s"] ** 3}
+    if name == "MassSpringDamper":  # the CasADi SDOF reference without hysteresis, the same built-in sweep
+        out = integrate.simulate_cvodes(models.sdof(), t, params={"alpha": 0.0}, rtol=1e-12,
+                                        excitation=Excitation(kind=2, amplitude=120.0, f_start=0.0, f_end=60.0,
+                                                              rate=0.5))
+        return {"y": out["y"], "v": out["v"]}
+    if name == "DamperElement":  # the CasADi damper reference (clamp force from the momentum balance)
+        out = integrate.simulate_cvodes(models.damper(), t, rtol=1e-12, inputs={
+            k: csv[k] for k in ("x_base", "v_base", "a_base")})
+        return {k: out[k] for k in ("F_clamp", "x1", "x2")}
+    return None
+
+
+@pytest.mark.parametrize("name", [n for n in REFERENCE_RUNS if n != "ConductorSpan"])
+def test_committed_reference_results_match_an_independent_computation(name, measured):
+    """docs/fmus/<name>/<name>_ref.csv (what users of other tools compare with) against scipy or the CasADi
+    reference: not against the FMU that wrote it."""
+    csv = _committed(name)
+    ref = _independent(name, csv)
+    worst = max(np.max(np.abs(csv[o] - ref[o])) / np.max(np.abs(ref[o])) for o in ref)
+    measured(f"committed reference CSV of {name} vs an independent computation: max|Δ|/max over "
+             f"{', '.join(ref)}", worst, 1e-7)
+
+
+def test_committed_span_reference_is_reproduced_by_the_fmu_built_now(fmu_dir, tmp_path, measured):
+    """The span has no second implementation here (its physics: tests/test_span.py against analytic modes);
+    its committed reference CSV is checked to be what today's FMU gives."""
+    committed = _committed("ConductorSpan")
+    fresh = np.genfromtxt(write_docs("ConductorSpan", fmu_dir / "ConductorSpan.fmu", tmp_path) /
+                          "ConductorSpan_ref.csv", delimiter=",", names=True)
     assert committed.dtype.names == fresh.dtype.names
-    for col in committed.dtype.names:
-        scale = max(np.max(np.abs(committed[col])), 1e-300)
-        assert np.max(np.abs(committed[col] - fresh[col])) <= 1e-8 * scale, col
+    worst = max(np.max(np.abs(committed[c] - fresh[c])) / max(np.max(np.abs(committed[c])), 1e-300)
+                for c in committed.dtype.names)
+    measured("committed ConductorSpan reference CSV vs the FMU built now (regression)", worst, 1e-9)

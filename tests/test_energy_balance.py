@@ -58,15 +58,16 @@ def test_damper_table_interpolates_power_law_exactly():
     assert table.valid_amplitude(0) == amps[3] and math.isnan(table.at(0, amps[4] * 1.1))
 
 
-def test_damper_fmu_power_matches_independent_harmonic_solution(fmu_dir):
+def test_damper_fmu_power_matches_independent_harmonic_solution(fmu_dir, measured):
     # linear damper (Bouc-Wen and cubic off): mean power at the clamp vs the 6-DOF harmonic solution.
     # Tolerance: the steady state is averaged over whole periods after 6 s; the slowest transient (10.1 Hz,
     # zeta 2.2 %) has decayed to exp(-0.022 * 63.5 * 6) = 2e-4 of its start by then.
     linear = {"k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0}
     freqs, amps = [5.0, 10.0, 17.3, 30.0], [5e-4]
     table = eb.damper_power_table(fmu_dir / "DamperElement.fmu", freqs, amps, linear, workers=1, progress=False)
-    for i, f in enumerate(freqs):
-        assert table.power[i, 0] == pytest.approx(clamp_power(f, amps[0]), rel=1e-3), f
+    measured("damper FMU mean clamp power, linear damper, 0.5 mm at 5, 10, 17.3, 30 Hz vs a harmonic solution of "
+             "independently assembled 6-DOF matrices: max relative error",
+             max(abs(table.power[i, 0] / clamp_power(f, amps[0]) - 1) for i, f in enumerate(freqs)), 1e-3)
     assert np.nanmax(table.drift) < 1e-3
 
 

@@ -232,14 +232,16 @@ def _resonance_log_psd_residuals(x):
     return log_psd(np.asarray(x)) - log_psd(np.array([0.52, 0.3]))
 
 
-def test_trust_region_nno_pins_frequency_and_damping_of_a_resonance():
+def test_trust_region_nno_pins_frequency_and_damping_of_a_resonance(measured):
     """Where a global surrogate cannot resolve a sharp resonance from 10-40 samples (it left zeta off by
     0.07-0.16 in unit terms on seeds 0-2 when this test was written), the trust-region box keeps the GA where
     the surrogate has been checked: f0 within 0.06 Hz and zeta within 1e-4 after 40 true evaluations."""
     settings = NNOSettings(init_sim=10, max_sim=40, fun_tol=0.0, p_size=20, ga_generations=40, seed=2,
                            trust_region=True)
     tr = nno(_resonance_log_psd_residuals, 2, settings)
-    np.testing.assert_allclose(tr.x, [0.52, 0.3], atol=2e-3)
+    measured("trust-region NNO, log-PSD of one resonance (f0 over 20–50 Hz, ζ over 0.5–5.5 %), 40 evaluations: "
+             "|f0 − 35.6 Hz| [Hz]", 30.0 * abs(tr.x[0] - 0.52), 0.06)
+    measured("the same: |ζ − 2 %|", 0.05 * abs(tr.x[1] - 0.3), 1e-4)
     radii = [h["radius"] for h in tr.history if h.get("radius") is not None]
     assert min(radii) < 0.5 and all(settings.x_tol <= r <= 0.5 for r in radii)
 

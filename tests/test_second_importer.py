@@ -43,19 +43,19 @@ def on_grid(result, name, dt=1e-3):
 
 
 @pytest.mark.parametrize("name", list(CASES))
-def test_fmi_sim_matches_fmpy_with_the_same_fixed_step_method(fmu_dir, tmp_path, name):
+def test_fmi_sim_matches_fmpy_with_the_same_fixed_step_method(fmu_dir, tmp_path, name, measured):
     outputs, params, stop = CASES[name]
     fmu = fmu_dir / f"{name}.fmu"
     other = fmi_sim(fmu, "model-exchange", STEP, stop, params, tmp_path)
     ours = fmpy_run(fmu, "Euler", STEP, stop, params, outputs)
     assert len(other) == len(ours)
     np.testing.assert_allclose(other["time"], ours["time"], atol=1e-12)
-    for o in outputs:
-        assert np.max(np.abs(other[o] - ours[o])) / np.max(np.abs(ours[o])) <= 1e-9, o
+    measured(f"{name}: fmi-sim 0.7 (Rust) vs fmpy, the same forward-Euler step 1e-5 s: max|Δy|/max|y|",
+             max(np.max(np.abs(other[o] - ours[o])) / np.max(np.abs(ours[o])) for o in outputs), 1e-9)
 
 
 @pytest.mark.parametrize("name", list(CASES))
-def test_fmi_sim_euler_converges_to_cvode_at_first_order(fmu_dir, tmp_path, name):
+def test_fmi_sim_euler_converges_to_cvode_at_first_order(fmu_dir, tmp_path, name, measured):
     outputs, params, stop = CASES[name]
     fmu = fmu_dir / f"{name}.fmu"
     ref = on_grid(fmpy_run(fmu, "CVode", 1e-3, stop, params, outputs), outputs[0])
@@ -65,13 +65,14 @@ def test_fmi_sim_euler_converges_to_cvode_at_first_order(fmu_dir, tmp_path, name
         errors.append(np.max(np.abs(run - ref)) / np.max(np.abs(ref)))
     # forward Euler: global error proportional to the step
     assert errors[0] < 0.05
-    assert 1.7 < errors[0] / errors[1] < 2.3, errors
+    measured(f"{name}: fmi-sim Euler vs fmpy CVode, error ratio for h = 2e-5 → 1e-5 s (first order: 2)",
+             abs(errors[0] / errors[1] - 2), 0.3)
 
 
-def test_fmi_sim_co_simulation_uses_the_fmus_own_solver(fmu_dir, tmp_path, runner):
+def test_fmi_sim_co_simulation_uses_the_fmus_own_solver(fmu_dir, tmp_path, runner, measured):
     outputs, params, stop = CASES["SDOFBoucWen"]
     fmu = fmu_dir / "SDOFBoucWen.fmu"
     other = fmi_sim(fmu, "co-simulation", 1e-3, stop, params, tmp_path)
     ours = runner("SDOFBoucWen").simulate(stop, 1e-3, outputs, params, tolerance=1e-8)
-    for o in outputs:
-        assert np.max(np.abs(other[o] - ours[o])) / np.max(np.abs(ours[o])) <= 1e-6, o
+    measured("SDOFBoucWen: fmi-sim co-simulation (the FMU's own solver) vs pyfit: max|Δy|/max|y|",
+             max(np.max(np.abs(other[o] - ours[o])) / np.max(np.abs(ours[o])) for o in outputs), 1e-6)

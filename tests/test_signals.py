@@ -6,14 +6,14 @@ from pyfit.analysis import signals
 from pyfit.analysis.excitation import multisine
 
 
-def test_psd_of_a_sine_peaks_at_its_frequency_and_integrates_to_its_variance():
+def test_psd_of_a_sine_peaks_at_its_frequency_and_integrates_to_its_variance(measured):
     fs, f0, amp = 1000.0, 37.3, 2.5
     t = np.arange(200_000) / fs
     y = amp * np.sin(2 * np.pi * f0 * t + 0.3)
     f, p = signals.welch_psd(y, fs, segment_s=8.0)
     peak, _ = signals.psd_peak(y, fs, segment_s=8.0)
     assert peak == pytest.approx(f0, abs=f[1] - f[0])
-    assert np.trapezoid(p, f) == pytest.approx(np.var(y), rel=0.01)  # Parseval: amp^2/2
+    measured("Welch PSD (Hann) of a pure sine: |∫PSD df / variance − 1|", abs(np.trapezoid(p, f) / np.var(y) - 1), 1e-3)
 
 
 def test_uniform_grid_is_asserted():
@@ -21,7 +21,7 @@ def test_uniform_grid_is_asserted():
         signals.assert_uniform(np.array([0.0, 0.1, 0.25, 0.3]))
 
 
-def test_frf_of_linear_two_dof_matches_analytic(runner):
+def test_frf_of_linear_two_dof_matches_analytic(runner, measured):
     # TwoDOF (a) with the Bouc-Wen element linearised (beta = 0: z = alpha*y2), whole-period multisine
     fs, n = 1000.0, 2000
     u = multisine(n, fs, 2.0, 40.0, 5.0, seed=3)
@@ -41,10 +41,11 @@ def test_frf_of_linear_two_dof_matches_analytic(runner):
     # the input is linear between samples: compare away from anti-resonances (|H| not tiny)
     ok = np.abs(H_ref) > 0.2 * np.median(np.abs(H_ref))
     assert ok.sum() > 0.8 * len(f)
-    assert np.max(np.abs(H[ok] - H_ref[ok]) / np.abs(H_ref[ok])) < 0.01
+    measured("FRF of TwoDOF (a), β = 0, from whole multisine periods vs the analytic FRF of hand-assembled M, C, K "
+             "(away from anti-resonances): max relative error", np.max(np.abs(H[ok] - H_ref[ok]) / np.abs(H_ref[ok])), 0.01)
 
 
-def test_loop_area_equals_dissipated_energy_per_cycle(runner):
+def test_loop_area_equals_dissipated_energy_per_cycle(runner, measured):
     f_exc = 5.0
     outputs = ["y", "v", "z", "F"]
     res = runner("SDOFBoucWen").simulate(4.0, 1e-4, outputs, {"exc_type": 1, "exc_f_start": f_exc,
@@ -55,11 +56,13 @@ def test_loop_area_equals_dissipated_energy_per_cycle(runner):
     viscous = np.sum(10.0 * last["v"] ** 2) * dt
     hysteretic = signals.loop_area(last["y"], last["z"])
     assert hysteretic > 0.1 * area
-    assert area == pytest.approx(viscous + hysteretic, rel=0.02)
+    measured("SDOF stepped sine 5 Hz: |loop area ∮F·dy − (viscous ∮c·v²dt + Bouc-Wen ∮z·dy)| / area",
+             abs(area - (viscous + hysteretic)) / area, 0.02)
 
 
-def test_damper_power_at_constant_velocity_is_positive_and_equals_loop_area(runner):
+def test_damper_power_at_constant_velocity_is_positive_and_equals_loop_area(runner, measured):
     outputs = ["F_clamp", "v_clamp", "x_clamp"]
+    worst = 0.0
     for f_exc in (8.0, 10.0, 16.0, 20.0, 25.0):  # whole samples per period at 1e-4 s
         res = runner("StockbridgeDamper").simulate(
             6.0, 1e-4, outputs, {"exc_type": 1, "exc_f_start": f_exc, "exc_amplitude": 0.05 / (2 * np.pi * f_exc),
@@ -67,11 +70,12 @@ def test_damper_power_at_constant_velocity_is_positive_and_equals_loop_area(runn
         assert res.ok
         cyc = signals.steady_cycle(res.time, res["F_clamp"], res["v_clamp"], res["x_clamp"], f_exc)
         assert cyc.mean_power > 0
-        assert cyc.dissipated_energy * f_exc == pytest.approx(cyc.mean_power, rel=0.02)
         assert cyc.impedance > 0
+        worst = max(worst, abs(cyc.dissipated_energy * f_exc / cyc.mean_power - 1))
+    measured("damper at constant clamp velocity, 8–25 Hz: |loop area × f / mean(F_clamp·v_clamp) − 1|", worst, 1e-4)  # trapezoid loop at ωΔt ≤ 0.016: O((ωΔt)²/12)
 
 
-def test_damper_power_and_impedance_from_a_slow_sweep_match_stepped_sines(runner):
+def test_damper_power_and_impedance_from_a_slow_sweep_match_stepped_sines(runner, measured):
     from pyfit.analysis.excitation import Excitation
 
     v0, rate = 0.03, 0.25
@@ -82,14 +86,17 @@ def test_damper_power_and_impedance_from_a_slow_sweep_match_stepped_sines(runner
     at = [12.5, 20.0, 25.0]  # away from the resonances, where a slow sweep is quasi-steady
     power, impedance = signals.sweep_power_impedance(sweep.time, sweep["F_clamp"], sweep["v_clamp"], exc.phase,
                                                      exc.frequency, at)
+    dp = dz = 0.0
     for f, p, z in zip(at, power, impedance):
         res = damper.simulate(5.0, 1e-4, ["F_clamp", "v_clamp", "x_clamp"], {
             "exc_type": 1, "exc_f_start": f, "exc_amplitude": v0 / (2 * np.pi * f), "exc_t_ramp": 0.5},
             tolerance=1e-10)
         cyc = signals.steady_cycle(res.time, res["F_clamp"], res["v_clamp"], res["x_clamp"], f)
         assert p > 0
-        assert p == pytest.approx(cyc.mean_power, rel=0.05)
-        assert z == pytest.approx(cyc.impedance, rel=0.03)
+        dp, dz = max(dp, abs(p / cyc.mean_power - 1)), max(dz, abs(z / cyc.impedance - 1))
+    measured("damper power along a 0.25 Hz/s constant-velocity sweep vs stepped sines (12.5, 20, 25 Hz): max "
+             "relative difference", dp, 0.05)
+    measured("damper impedance, the same sweep vs stepped sines: max relative difference", dz, 0.03)
 
 
 def test_daq_grade_anti_alias_fir_is_flat_where_scipy_default_is_not():

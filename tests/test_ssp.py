@@ -13,7 +13,7 @@ CONNECTIONS = [Connection("mass.y", "bw.s", "mass.v"), Connection("mass.v", "bw.
                Connection("bw.f", "mass.f", "bw.df")]
 
 
-def test_coupled_sdof_as_ssp_validates_and_runs_in_fmpy(fmu_dir, runner, tmp_path):
+def test_coupled_sdof_as_ssp_validates_and_runs_in_fmpy(fmu_dir, runner, tmp_path, measured):
     ssp = write_ssp(tmp_path / "sdof.ssp", "CoupledSDOF", {"mass": fmu_dir / "MassSpringDamper.fmu",
                                                             "bw": fmu_dir / "BoucWenElement.fmu"},
                     CONNECTIONS, {"mass": EXC}, stop_time=0.5)
@@ -25,4 +25,5 @@ def test_coupled_sdof_as_ssp_validates_and_runs_in_fmpy(fmu_dir, runner, tmp_pat
     mono = runner("SDOFBoucWen").simulate(0.5, 1e-4, ["y"], dict(EXC), tolerance=1e-10)["y"]
     y = np.interp(np.arange(len(mono)) * 1e-4, res["time"], res["mass.y"])
     # fmpy couples with held inputs (first order): 4 % at this step; ours with extrapolation: 3e-5
-    assert np.sqrt(np.mean((y - mono) ** 2)) / np.sqrt(np.mean(mono**2)) < 0.1
+    measured("coupled SDOF as SSP 1.0 in fmpy's SSP simulator (held inputs, 1e-4 s) vs the monolithic FMU: RMS(Δy)/RMS(y)",
+             np.sqrt(np.mean((y - mono) ** 2)) / np.sqrt(np.mean(mono**2)), 0.06)

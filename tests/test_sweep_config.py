@@ -36,21 +36,25 @@ def _write(tmp_path, text, name="study.toml"):
     return p
 
 
-def test_sweep_study_results_and_linear_energy_per_cycle(fmu_dir, tmp_path):
+def test_sweep_study_results_and_linear_energy_per_cycle(fmu_dir, tmp_path, measured):
     cfg = load_sweep(_write(tmp_path, STUDY), lambda m: fmu_interface(fmu_dir / f"{m}.fmu"))
     rows = run_study(cfg, fmu_dir, tmp_path / "out", workers=2, progress=False)
     assert len(rows) == 8 and all(r["ok"] for r in rows)
     with open(tmp_path / "out" / "summary.csv") as f:
         assert len(list(csv.DictReader(f))) == 8
     assert (tmp_path / "out" / "SDOFBoucWen_loops.png").stat().st_size > 10_000
+    power_vs_loop = linear_energy = 0.0
     for r in rows:
-        assert r["mean_power_w"] == pytest.approx(r["loop_energy_j"] * r["frequency_hz"], rel=0.02)
+        power_vs_loop = max(power_vs_loop, abs(r["mean_power_w"] / (r["loop_energy_j"] * r["frequency_hz"]) - 1))
         if r["parameter_set"] == "linear":
             # linear oscillator: energy per cycle = pi * c * omega * Y^2
             y = np.loadtxt(tmp_path / "out" / "runs" / f"{r['label']}.csv", delimiter=",", skiprows=1)[:, 1]
             n = int(round(1 / r["frequency_hz"] / 1e-4))
             amp = (np.max(y[-n:]) - np.min(y[-n:])) / 2
-            assert r["loop_energy_j"] == pytest.approx(np.pi * 10.0 * 2 * np.pi * r["frequency_hz"] * amp**2, rel=0.02)
+            linear_energy = max(linear_energy, abs(r["loop_energy_j"] / (np.pi * 10.0 * 2 * np.pi * r["frequency_hz"]
+                                                                          * amp**2) - 1))
+    measured("sweep study, every sine run: |mean power / (loop energy × f) − 1|", power_vs_loop, 1e-4)  # trapezoid loop, O((ωΔt)²)
+    measured("sweep study, linear SDOF: |loop energy / (π·c·ω·Y²) − 1|", linear_energy, 0.02)
     hyst = {(r["level"], r["frequency_hz"]): r["loop_energy_j"] for r in rows if r["parameter_set"] == "hysteretic"}
     lin = {(r["level"], r["frequency_hz"]): r["loop_energy_j"] for r in rows if r["parameter_set"] == "linear"}
     assert all(hyst[k] > lin[k] for k in hyst)  # hysteresis dissipates on top of the viscous damper

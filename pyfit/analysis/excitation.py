@@ -177,3 +177,16 @@ class PeriodicSignal:
         t = np.asarray(t, float)
         return self.mean + np.sum(self.amplitudes[:, None] * np.cos(np.outer(self.omegas, t.ravel())
                                                                      + self.phases[:, None]), axis=0).reshape(t.shape)
+
+
+def motion_with_derivatives(exc: Excitation, t: np.ndarray, names: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """A prescribed motion and its exact first and second derivatives on the grid t [s] (CasADi AD), named
+    by `names` (e.g. x_base, v_base, a_base)."""
+    import casadi as ca
+
+    ts = ca.SX.sym("t")
+    x = exc(ts)
+    dx = ca.jacobian(x, ts)
+    f = ca.Function("motion", [ts], [x, dx, ca.jacobian(dx, ts)])
+    cols = [np.array(c).ravel() for c in f.map(len(t))(t[None, :])]
+    return dict(zip(names, cols))

@@ -4,24 +4,13 @@ from __future__ import annotations
 
 import pathlib
 
-import casadi as ca
 import numpy as np
 
-from pyfit.analysis.excitation import Excitation
+from pyfit.analysis.excitation import Excitation, motion_with_derivatives
 from pyfit.runtime.fmu import FmuRunner
 
 STEP = 1e-3  # s, output interval of the reference runs and spacing of their (linear) input samples
 STOP = 0.5  # s
-
-
-def motion_with_derivatives(exc: Excitation, t: np.ndarray, names: tuple[str, ...]) -> dict[str, np.ndarray]:
-    """A prescribed motion and its exact first and second derivatives on the grid t."""
-    ts = ca.SX.sym("t")
-    x = exc(ts)
-    dx = ca.jacobian(x, ts)
-    f = ca.Function("motion", [ts], [x, dx, ca.jacobian(dx, ts)])
-    cols = [np.array(c).ravel() for c in f.map(len(t))(t[None, :])]
-    return dict(zip(names, cols))
 
 
 SINE_2MM = Excitation(kind=1, amplitude=2e-3, f_start=10.0)  # m, Hz

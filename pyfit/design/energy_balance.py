@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from pyfit.analysis import plots
+from pyfit.report import plots
 from pyfit.runtime.batch import RunSpec, run_batch
 from pyfit.design.span import span_properties
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyfit.analysis import plots
+from pyfit.report import plots
 from pyfit.runtime.cosim import Connection, cosimulate
 from pyfit.runtime.fmu import FmuRunner
 

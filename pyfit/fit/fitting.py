@@ -11,7 +11,7 @@ from dataclasses import asdict
 import numpy as np
 
 from pyfit import __version__
-from pyfit.analysis import plots
+from pyfit.report import plots
 from pyfit.io import benchmark_data
 from pyfit.io.data import read_measurement
 from pyfit.io.fit_config import FitConfig

@@ -45,6 +45,7 @@ class FitTask:
     budget: int
     upsample: int
     lead_periods: int = 1
+    scan: tuple = ()  # (parameter, factors): the start is the best of start[parameter] x each factor
 
 
 def _stacked(runner, records, params: dict, upsample: int, lead_periods: int) -> np.ndarray:
@@ -64,29 +65,52 @@ def run_fit(task: FitTask) -> Fit:
     def params(x):
         return {**task.fixed, **dict(zip(names, lo + np.clip(x, 0, 1) * (hi - lo)))}
 
-    x0 = (np.array([task.start[n] for n in names]) - lo) / (hi - lo)
     def residuals(p):
         return _stacked(runner, task.records, p, task.upsample, task.lead_periods)
 
+    x0 = (np.array([task.start[n] for n in names]) - lo) / (hi - lo)
+    scanned = 0
+    if task.scan:  # find the basin: the start with one parameter scaled, best time-domain residual
+        name, factors = task.scan
+        j = names.index(name)
+        candidates = []
+        for f in factors:
+            x = x0.copy()
+            x[j] = (task.start[name] * f - lo[j]) / (hi[j] - lo[j])
+            candidates.append(np.clip(x, 0.0, 1.0))
+        errors = [float(np.sum(residuals(params(x)) ** 2)) for x in candidates]
+        x0, scanned = candidates[int(np.argmin(errors))], len(candidates)
+    # least squares from there; it returns the best point it evaluated, so never worse than its start
     result = polish(lambda x: residuals(params(x)), x0, budget=task.budget)
     best = params(result.x)
-    err = float(np.sqrt(np.sum(residuals(best) ** 2) / len(task.records)))
+    err = float(np.sqrt(result.error / len(task.records)))
     runner.close()
     return Fit(task.effect, {k: float(v) for k, v in best.items()}, names, task.n_added, err,
-               result.n_evaluations + 1, time.perf_counter() - t0)
+               result.n_evaluations + scanned, time.perf_counter() - t0)
+
+
+STIFFNESS_SCAN = (0.25, 0.5, 1.0, 2.0, 4.0)  # factors on the nominal stiffness tried before the least squares
 
 
 def nominal_task(system: System, fmu: str, records: list, budget: int, upsample: int) -> FitTask:
-    """The nominal (linear) calibration from the system's start (the SDOF: its measured FRF)."""
+    """The nominal (linear) calibration: from the system's start (the SDOF: its measured FRF; the damper: the
+    described values), the best of the stiffness scaled by STIFFNESS_SCAN, then least squares."""
     start = system.start(records)
+    bounds = system.bounds(start)
+    scan = (system.stiffness, STIFFNESS_SCAN) if system.stiffness in start else ()
+    if scan:  # let the bounds hold the whole scan
+        lo, hi = bounds[system.stiffness]
+        bounds[system.stiffness] = (min(lo, start[system.stiffness] * min(STIFFNESS_SCAN)),
+                                    max(hi, start[system.stiffness] * max(STIFFNESS_SCAN)))
     return FitTask(fmu, tuple(records), dict(system.nominal_fixed), {n: start[n] for n in system.linear},
-                   system.bounds(start), "nominal", 0, budget, upsample, system.lead_periods)
+                   bounds, "nominal", 0, budget, upsample, system.lead_periods, scan)
 
 
 def effect_start(system: System, effect: Effect, scale: Scale, nominal: dict) -> tuple[dict, dict, dict]:
     """Start values, bounds and fixed parameters of the nominal model with `effect` added."""
     start = {n: nominal[n] for n in system.linear}
-    start[system.stiffness] = nominal[system.stiffness] * (1.0 - effect.shift_stiffness)
+    if system.stiffness in start:  # a hysteretic element takes over part of the stiffness
+        start[system.stiffness] = nominal[system.stiffness] * (1.0 - effect.shift_stiffness)
     bounds = system.bounds(nominal, softened=effect.shift_stiffness > 0)
     for p in effect.params:
         lo, st, hi = p.range(scale)
@@ -130,10 +154,11 @@ def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, 
     for name in effects:
         effect = system.effects[name]
         start, _, fixed = effect_start(system, effect, scale, base)
-        p = {**base, **fixed, system.stiffness: start[system.stiffness]}
+        p = {**base, **fixed, **{n: start[n] for n in system.linear}}
         for prm in effect.params:
             lo, st, hi = prm.range(scale)
-            p[prm.name] = st if st != 0 else probe * (hi if hi > 0 else lo)
+            # a hysteretic element at its start (more than a stiffness there); any other a small step from it
+            p[prm.name] = st if effect.shift_stiffness > 0 else st + probe * (hi - st)
         d = stacked(p) - r0
         out[name] = 1.0 - unexplained(np.column_stack([J, d])) / lin if lin > 0 else 0.0
     runner.close()

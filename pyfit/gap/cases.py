@@ -11,12 +11,14 @@ from pyfit.gap.diagnose import DiagnoseConfig, diagnose
 
 
 def run_cases(root, out_dir, cfg: DiagnoseConfig | None = None, model: str = "sdof", fmu_dir="fmus",
-              workers: int | None = None) -> list[dict]:
-    """Diagnose every sub-folder of root holding a dataset; OUT/<case>/report.*, OUT/summary.md."""
+              workers: int | None = None, nominal=None) -> list[dict]:
+    """Diagnose every sub-folder of root holding a dataset (against the nominal model described, if any);
+    OUT/<case>/report.*, OUT/summary.md."""
     rows = []
     for case in sorted(p for p in pathlib.Path(root).iterdir() if p.is_dir() and any(p.glob("*.csv"))):
         t0 = time.perf_counter()
-        rep = diagnose(model, case, pathlib.Path(out_dir) / case.name, cfg, fmu_dir, workers, progress=False)
+        rep = diagnose(model, case, pathlib.Path(out_dir) / case.name, cfg, fmu_dir, workers, progress=False,
+                       nominal=nominal)
         truth = json.loads((case / "truth.json").read_text())["effect"] if (case / "truth.json").is_file() else None
         expected = None if truth in (None, "none") else truth
         top = rep["ranking"][0] if rep["ranking"] else None

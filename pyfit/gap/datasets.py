@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pyfit.io.data import write_measurement
-from pyfit.analysis.excitation import PeriodicSignal, multisine
-from pyfit.reference.synthetic import SyntheticSpec, simulate_truth
+from pyfit.analysis.excitation import Excitation, PeriodicSignal, motion_with_derivatives, multisine
+from pyfit.reference.synthetic import UNITS, SyntheticSpec, simulate_truth
 
 
 @dataclass(frozen=True)
@@ -49,74 +49,127 @@ SDOF = Family(
     (10.0, 25.0, 50.0), "N", (5.0, 80.0), 500.0, 2048, 1, ("y",), 5e-6)
 
 _DAMPER_OFF = {"k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "F_c1": 0.0, "F_c2": 0.0, "c2_1": 0.0,
-               "c2_2": 0.0, "a1": 0.0, "a2": 0.0}
+               "c2_2": 0.0}
 DAMPER = Family(
-    "StockbridgeDamper", dict(_DAMPER_OFF),  # the linear FE damper of design 1.3, masses centred on the cable
+    "StockbridgeDamper", dict(_DAMPER_OFF),  # the linear FE damper of design 1.3, its eccentric masses included
     {"hysteresis": {"k_bw1": 600.0, "k_bw2": 1000.0, "D": 2e-4},
      "cubic_stiffness": {"k_cs1": 8e8, "k_cs2": 2.4e9},  # hardening: the seed's softening diverges here
      "coulomb_friction": {"F_c1": 0.08, "F_c2": 0.12, "v_s": 1e-3},
      "quadratic_damping": {"c2_1": 12.0, "c2_2": 20.0},
-     "mass_eccentricity": {"a1": 0.015, "a2": 0.015},
+     "mass_eccentricity": {"a1": lambda p: p["a1"] + 0.015, "a2": lambda p: p["a2"] + 0.015},  # 15 mm further out
      "none": {}},
-    {"k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "F_c1": 0.0, "F_c2": 0.0, "c2_1": 0.0, "c2_2": 0.0,
-     "a1": 0.0, "a2": 0.0},
+    dict(_DAMPER_OFF),
     (0.05e-3, 0.1e-3, 0.2e-3), "mm", (5.0, 40.0), 500.0, 2048, 2, ("x1", "x2"), 2e-6)
 
 FAMILIES = {"sdof": SDOF, "damper": DAMPER}
 PERIODS = 3
 
 
-def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: int = PERIODS) -> pathlib.Path:
-    """Write one dataset (a file per level) whose truth has `effect` ('none' for a null case);
+SWEEP_LEVELS = {"SDOFBoucWen": ((10.0, 25.0, 50.0), "N"),  # force amplitude
+                "StockbridgeDamper": ((0.005, 0.01, 0.02), "m/s")}  # clamp velocity amplitude
+
+
+@dataclass(frozen=True)
+class LabStyle:
+    """How a test bench would have recorded a case: the excitation ('multisine': steady-state periods;
+    'sweep': a linear sweep over the family's band from rest, sweep_s long, constant force amplitude for the
+    SDOF and constant clamp-velocity amplitude for the damper), the outputs recorded (None: the family's
+    displacements; e.g. ("a",) or ("acc_x1", "acc_x2") for accelerometers) and which of the clamp's x, v,
+    a were recorded (the damper's shaker controller gives all three; an accelerometer only 'a')."""
+
+    excitation: str = "multisine"
+    outputs: tuple | None = None
+    motion: str = "xva"
+    sweep_s: float = 35.0
+
+
+def _truth_params(family: Family, effect: str, base: dict) -> dict:
+    """Truth = linear + base (a described system) + the effect; an effect value may be a function of the
+    system's parameters (a deviation from them, e.g. mass offsets)."""
+    from pyfit.reference.models import by_name
+
+    system = {**by_name(family.model).defaults, **family.linear, **base}
+    extra = {k: (v(system) if callable(v) else v) for k, v in family.withheld[effect].items()}
+    return {**family.linear, **base, **extra}
+
+
+def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: int = PERIODS,
+                  style: LabStyle = LabStyle(), base: dict | None = None) -> pathlib.Path:
+    """Write one dataset (a file per level) whose truth has `effect` ('none' for a null case), as recorded in
+    `style`, of the system `base` (FMU parameter overrides, e.g. a described damper; None: the defaults);
     truth.json beside it records the truth and what the effect changes at each level against the truth
     without it (Bouc-Wen as its tangent stiffness): the output RMS (RMS(y)/RMS(y_tangent) - 1) and the
     output itself (RMS(y - y_tangent)/RMS(y_tangent)); the diagnosis never reads it."""
     if effect not in family.withheld:
         raise ValueError(f"effect '{effect}' unknown for {family.model}; allowed: {', '.join(family.withheld)}")
+    if style.excitation not in ("multisine", "sweep"):
+        raise ValueError(f"excitation '{style.excitation}' unknown; allowed: multisine, sweep")
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    truth = {**family.linear, **family.withheld[effect]}
+    truth = _truth_params(family, effect, base or {})
+    recorded = tuple(style.outputs or family.outputs)
     spp, fs, lead = family.samples_per_period, family.fs, family.lead_periods
-    keep = slice(lead * spp, (lead + periods) * spp)
     rng = np.random.default_rng(seed)
     changes = {}
-    for i, level in enumerate(family.levels):
-        signal = PeriodicSignal(multisine(spp, fs, *family.band_hz, level, seed, odd=True), fs)
-        stop = (lead + periods + 1) * spp / fs
-        t, exact, _ = simulate_truth(SyntheticSpec(family.model, signal, stop, fs, list(family.outputs), truth,
+    sweep = style.excitation == "sweep"
+    levels, unit = SWEEP_LEVELS[family.model] if sweep else (family.levels, family.level_unit)
+    for i, level in enumerate(levels):
+        if sweep:
+            f0, f1 = family.band_hz
+            kind = 2 if family.model == "SDOFBoucWen" else 4
+            signal = Excitation(kind, level, f0, f1, (f1 - f0) / (style.sweep_s - 1.0), t_ramp=1.0)
+            stop, keep = style.sweep_s, slice(0, int(round(style.sweep_s * fs)))
+        else:
+            signal = PeriodicSignal(multisine(spp, fs, *family.band_hz, level, seed, odd=True), fs)
+            stop, keep = (lead + periods + 1) * spp / fs, slice(lead * spp, (lead + periods) * spp)
+        t, exact, _ = simulate_truth(SyntheticSpec(family.model, signal, stop, fs, list(recorded), truth,
                                                    oversample=10))
-        clean = simulate_truth(SyntheticSpec(family.model, signal, stop, fs, list(family.outputs),
+        clean = simulate_truth(SyntheticSpec(family.model, signal, stop, fs, list(recorded),
                                              {**truth, **family.tangent}, oversample=10))[1]
         tk = t[keep] - t[keep][0]
-        num = sum(np.mean((exact[o][keep] - clean[o][keep]) ** 2) for o in family.outputs)
-        den = sum(np.mean(clean[o][keep] ** 2) for o in family.outputs)
-        rms = sum(np.mean(exact[o][keep] ** 2) for o in family.outputs)
+        num = sum(np.mean((exact[o][keep] - clean[o][keep]) ** 2) for o in recorded)
+        den = sum(np.mean(clean[o][keep] ** 2) for o in recorded)
+        rms = sum(np.mean(exact[o][keep] ** 2) for o in recorded)
         key = f"{level:g}"
         changes[key] = {"rms": float(np.sqrt(rms / den) - 1.0), "output": float(np.sqrt(num / den))}
         if family.model == "SDOFBoucWen":
             inputs = {"u_meas": (signal(t[keep]), "N", "u")}
         else:
-            inputs = {"x_base_meas": (signal(t[keep]), "m", "x_base"),
-                      "v_base_meas": (signal.derivative(t[keep], 1), "m/s", "v_base"),
-                      "a_base_meas": (signal.derivative(t[keep], 2), "m/s2", "a_base")}
-        outputs = {f"{o}_meas": (exact[o][keep] + rng.normal(0.0, family.noise, len(tk)), "m", o)
-                   for o in family.outputs}
-        shown = level * 1e3 if family.level_unit == "mm" else level
-        write_measurement(out / f"level{i + 1}_{shown:g}{family.level_unit}.csv", family.model, tk, inputs, outputs,
-                          level=f"RMS {shown:g} {family.level_unit}", level_value=shown,
-                          excitation={"kind": "multisine", "samples_per_period": spp, "periods": periods,
-                                      "f_min": family.band_hz[0], "f_max": family.band_hz[1], "rms": level,
-                                      "odd": True},
+            motion = (motion_with_derivatives(signal, t[keep], ("x", "v", "a")) if sweep else
+                      {"x": signal(t[keep]), "v": signal.derivative(t[keep], 1), "a": signal.derivative(t[keep], 2)})
+            inputs = {f"{var}_meas": (motion[k], u, var) for k, u, var in
+                      (("x", "m", "x_base"), ("v", "m/s", "v_base"), ("a", "m/s2", "a_base")) if k in style.motion}
+        outputs = {f"{o}_meas": (exact[o][keep] + rng.normal(0.0, _noise_of(family, o, clean[o][keep]), len(tk)),
+                                 UNITS.get(o, "m"), o) for o in recorded}
+        shown = level * 1e3 if unit == "mm" else level
+        name = f"level{i + 1}_{shown:g}{unit.replace('/', '')}.csv"
+        exc_meta = ({"kind": "linear_sweep", "f_start": family.band_hz[0], "f_end": family.band_hz[1],
+                     "amplitude": level} if sweep else
+                    {"kind": "multisine", "samples_per_period": spp, "periods": periods, "f_min": family.band_hz[0],
+                     "f_max": family.band_hz[1], "rms": level, "odd": True})
+        write_measurement(out / name, family.model, tk, inputs, outputs,
+                          level=f"{'amplitude' if sweep else 'RMS'} {shown:g} {unit}", level_value=shown,
+                          excitation=exc_meta,
                           notes=f"synthetic: CasADi reference (cvodes) at 10x the sensor rate, zero-phase FIR "
-                                f"anti-alias + decimation, noise {family.noise} m, seed {seed}")
+                                f"anti-alias + decimation, noise {family.noise} m (or its equivalent), seed {seed}")
     (out / "truth.json").write_text(json.dumps({"effect": effect, "params": truth, "seed": seed,
-                                                "rms_change": changes}, indent=1))
+                                                "style": style.__dict__, "rms_change": changes}, indent=1))
     return out
 
 
-def write_cases(out_dir, family: str = "sdof", null_seeds=(0, 1, 2), periods: int = PERIODS) -> list[pathlib.Path]:
+def _noise_of(family: Family, output: str, clean: np.ndarray) -> float:
+    """Sensor noise [SI] of a channel: the family's displacement noise, or for another quantity the same
+    fraction of its RMS as the displacement noise is of a displacement channel's RMS (about 0.3-1 %)."""
+    if UNITS.get(output, "m") == "m":
+        return family.noise
+    return 0.005 * float(np.sqrt(np.mean(clean**2)))
+
+
+def write_cases(out_dir, family: str = "sdof", null_seeds=(0, 1, 2), periods: int = PERIODS,
+                style: LabStyle = LabStyle(), base: dict | None = None) -> list[pathlib.Path]:
     """The test cases of a family: each effect withheld (seed 0) and the null case for every noise seed."""
     fam, out = FAMILIES[family], pathlib.Path(out_dir)
-    paths = [write_dataset(out / f"{family}_{e}", fam, e, periods=periods) for e in fam.withheld if e != "none"]
-    return paths + [write_dataset(out / f"{family}_none_seed{s}", fam, "none", seed=s, periods=periods)
-                    for s in null_seeds]
+    paths = [write_dataset(out / f"{family}_{e}", fam, e, periods=periods, style=style, base=base)
+             for e in fam.withheld if e != "none"]
+    return paths + [write_dataset(out / f"{family}_none_seed{s}", fam, "none", seed=s, periods=periods, style=style,
+                                  base=base) for s in null_seeds]

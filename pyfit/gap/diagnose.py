@@ -12,12 +12,14 @@ from dataclasses import asdict, dataclass, fields
 from pyfit.runtime.batch import map_tasks
 from pyfit.io.data import MeasurementError, read_dataset
 from pyfit.runtime.fmu import FmuRunner
+from pyfit.runtime.linearize import linear_modes
 from pyfit.runtime.examples import ensure_fmu
 from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read_toml
 from pyfit.gap import localise
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import Fit, effect_task, nominal_task, run_fit, screen
-from pyfit.gap.systems import get_system
+from pyfit.gap.systems import family_fmu, make_system
+from pyfit.io.nominal import NominalModel, load_nominal
 
 
 class DiagnoseError(ConfigError):
@@ -34,10 +36,14 @@ class DiagnoseConfig:
     nominal_budget: int = 60  # FMU evaluations of the nominal calibration
     refit_budget: int = 120  # FMU evaluations per refit with an effect
     upsample: int = 4  # FMU input grid = sensor rate x upsample
+    transient_s: float = 4.0  # a record that does not start at rest: seconds simulated from rest, not compared
     min_gap: float = 0.005  # NRMSE a gap must exceed beyond the noise floor to count
     noise_factor: float = 1.2  # ... and the noise floor times this
     close_points: float = 15.0  # runner-up within this many score points: reported as close
     min_shrink_pct: float = 50.0  # the best effect must shrink the gap by this much to be chosen
+    explain_factor: float = 3.0  # ... and bring the held-out NRMSE within explain_factor x the noise floor
+    explain_margin: float = 0.02  # ... or within the floor + explain_margin (the absolute criterion)
+    nominal_max_nrmse: float = 0.8  # a nominal whose calibration NRMSE exceeds this "does not fit"
 
 
 _SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
@@ -57,9 +63,13 @@ def load_config(path) -> DiagnoseConfig:
     return cfg
 
 
-def _load(data_dir, system, cfg: DiagnoseConfig):
-    """Records of the dataset, validated, split into calibration and held-out."""
+def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
+    """Records of the dataset, validated against the FMU's variables, split into calibration and held-out."""
     data_dir = pathlib.Path(data_dir)
+    md_vars = runner.model_description.modelVariables
+    variables = {v.name for v in md_vars}
+    allowed = {"inputs": [v.name for v in md_vars if v.causality == "input"],
+               "outputs": [v.name for v in md_vars if v.causality == "output"]}
     try:
         ms = read_dataset(data_dir)
     except MeasurementError as exc:
@@ -81,7 +91,16 @@ def _load(data_dir, system, cfg: DiagnoseConfig):
     if unknown:
         raise DiagnoseError(f"effects: '{unknown[0]}' unknown for {system.name}; allowed: "
                             f"{', '.join(system.effects)}")
-    records = [sim.record_of(m) for m in ms]
+    try:
+        records = [sim.record_of(m, system.motion_inputs, cfg.transient_s) for m in ms]
+    except ValueError as exc:
+        raise DiagnoseError(str(exc)) from exc
+    for m, r in zip(ms, records):
+        for kind, names in (("inputs", r.inputs), ("outputs", r.outputs)):
+            bad = [n for n in names if n not in variables]
+            if bad:
+                raise DiagnoseError(f"{m.path.with_suffix('.toml')}: [{kind}] model_variable '{bad[0]}' is not a "
+                                    f"variable of {system.fmu}; allowed: {', '.join(sorted(allowed[kind]))}")
     names = [r.name for r in records]
     if cfg.calibration:
         bad = [c for c in cfg.calibration if c not in names]
@@ -118,36 +137,70 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
     return None
 
 
+def fmu_defaults(runner: FmuRunner) -> dict[str, float]:
+    """The FMU's parameter start values (the .mo defaults), SI."""
+    return {v.name: float(v.start) for v in runner.model_description.modelVariables
+            if v.causality == "parameter" and v.start is not None and v.type == "Real"}
+
+
 def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, fmu_dir="fmus",
-             workers: int | None = None, progress: bool = True) -> dict:
+             workers: int | None = None, progress: bool = True, nominal: NominalModel | str | None = None) -> dict:
     """Diagnose the dataset against the nominal model `model` ('sdof' or 'damper'); writes OUT/report.json,
     OUT/report.md and figures; returns the report. When the nominal model already fits the held-out files
-    within the noise floor, no effect is refitted (verdict 'no significant gap')."""
+    within the noise floor, no effect is refitted (verdict 'no significant gap').
+
+    nominal: the user's description of the nominal model (a NominalModel or a TOML file, see
+    pyfit.io.nominal); None: the FMU's defaults (for the damper, the design 1.3 reference damper)."""
     from pyfit.gap import report
 
     cfg = cfg or DiagnoseConfig()
-    system = get_system(model)
-    records, cal, held, data_key = _load(data_dir, system, cfg)
+    fmu = str(ensure_fmu(family_fmu(model), pathlib.Path(fmu_dir)))
+    runner = FmuRunner(fmu)
+    described = load_nominal(nominal) if isinstance(nominal, (str, pathlib.Path)) else nominal
+    if described is not None:
+        if described.family != model:
+            raise DiagnoseError(f"{described.path}: [nominal.family] = '{described.family}' but the diagnosis is "
+                                f"of '{model}'")
+        described.check_names(set(runner.parameter_names()))
+    system = make_system(model, fmu_defaults(runner), described)
+    records, cal, held, data_key = _load(data_dir, system, cfg, runner)
+    lo, hi = localise.excited_range(records)
+    modes = linear_modes(fmu, {**system.nominal_fixed, **system.start(cal)})
+    if modes and not any(lo <= m.f_n <= hi for m in modes):
+        raise DiagnoseError(f"{data_dir}: the inputs excite {lo:.1f}-{hi:.1f} Hz but the nominal model's resonances "
+                            f"are at {', '.join(f'{m.f_n:.1f}' for m in modes)} Hz; allowed: an excitation band "
+                            "that holds at least one resonance (the data cannot calibrate the model otherwise)")
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)
-    fmu = str(ensure_fmu(system.fmu, pathlib.Path(fmu_dir)))
-    settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in ("min_gap", "noise_factor",
-                                                                             "close_points", "min_shrink_pct")},
-                          sort_keys=True)
-    key = hashlib.sha256((data_key + settings + model + ",".join(r.name for r in cal)).encode()).hexdigest()[:16]
+    judging = ("min_gap", "noise_factor", "close_points", "min_shrink_pct", "explain_factor", "explain_margin",
+               "nominal_max_nrmse")  # how results are judged, not how fits are made: stored fits stay valid
+    settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in judging}, sort_keys=True)
+    description = json.dumps({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}
+                             if described else {}, sort_keys=True)
+    key = hashlib.sha256((data_key + settings + model + description + ",".join(r.name for r in cal)).encode()
+                         ).hexdigest()[:16]
 
     nominal = _stored(out / "fits" / "nominal.json", key)
     if nominal is None:
         task = nominal_task(system, fmu, cal, cfg.nominal_budget, cfg.upsample)
         nominal = _fit_and_store((task, out / "fits" / "nominal.json", key))
-    scale = system.scale(cal, nominal.params)
-    runner = FmuRunner(fmu)
+    deflections = []
+    for r in cal:
+        moved = sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods,
+                             outputs=system.deflection_outputs)
+        if moved is None:
+            raise DiagnoseError(f"{r.name}: the calibrated nominal model fails on this file (parameters "
+                                f"{ {n: nominal.params[n] for n in nominal.free} })")
+        deflections.append(system.deflection(moved, r))
+    scale = system.scale(deflections, cal[0].fs, nominal.params)
     sims = {"nominal": {r.name: sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods) for r in records}}
     bands = [tuple(b) for b in cfg.bands_hz] if cfg.bands_hz else localise.default_bands(records)
     gap = report.nominal_gap(sims["nominal"], records, held, bands, cfg)
     screening, fits = {}, {}
     effects = cfg.effects or list(system.effects)
-    if gap["significant"]:  # otherwise the nominal model explains the data within its noise: nothing to attribute
+    # nothing to attribute when the nominal model fits the held-out files within their noise, or does not fit
+    # even its own calibration files
+    if gap["significant"] and nominal.calibration_nrmse <= cfg.nominal_max_nrmse:
         screening_path = out / "fits" / "screening.json"
         stored = json.loads(screening_path.read_text()) if screening_path.is_file() else {}
         if stored.get("key") == key:

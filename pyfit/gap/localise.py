@@ -8,6 +8,7 @@ say where the residual's energy lies.
 from __future__ import annotations
 
 import numpy as np
+import scipy.signal
 
 from pyfit.gap.simulate import Record
 
@@ -26,23 +27,66 @@ def _period_spectra(x: np.ndarray, spp: int) -> np.ndarray:
     return np.fft.rfft(x)[None, :]
 
 
+def _resolution_variance(y: np.ndarray) -> float:
+    """Variance of the rounding a file writer leaves: q^2/12 for the smallest step q between the record's
+    distinct values (a floor under any noise estimate; never zero for a non-constant record)."""
+    steps = np.diff(np.unique(y))
+    q = float(steps.min()) if steps.size else 0.0
+    return max(q * q / 12.0, 1e-16 * float(np.mean(y**2)))
+
+
+def _noise_variance(rec: Record, y: np.ndarray) -> tuple[float, str]:
+    """Noise variance of one output channel and how it was estimated:
+    - 'period scatter': two or more periods of a periodic record: the variance between periods;
+    - 'pre-excitation': the record starts with at least 0.2 s before the input rises above 1 % of its peak;
+    - 'unexcited lines': a single period of a periodic record: the DFT lines the input does not excite (an
+      upper bound: distortion lands there too);
+    - 'quiet band': white noise level from the output PSD between 3x the highest excited frequency and
+      0.4 fs (median over the bins, so that harmonic lines there do not count), when that band exists;
+    - 'coherence': otherwise the output power not coherent with the input over the excited band (an upper
+      bound: nonlinear distortion is not coherent either)."""
+    u = rec.compared(next(iter(rec.inputs)))
+    spp = rec.samples_per_period
+    if spp and rec.n // spp >= 2:
+        return float(np.mean(np.var(y[:rec.n // spp * spp].reshape(-1, spp), axis=0, ddof=1))), "period scatter"
+    rising = np.flatnonzero(np.abs(u) > 0.01 * np.max(np.abs(u)))
+    if rising.size and rising[0] >= 0.2 * rec.fs:
+        return float(np.var(y[:rising[0]])), "pre-excitation"
+    if spp:
+        U, Y = np.fft.rfft(u), np.fft.rfft(y)
+        quiet = np.abs(U) ** 2 < 1e-8 * np.max(np.abs(U) ** 2)
+        quiet[0] = False
+        if quiet.any():
+            return float(np.mean(np.abs(Y[quiet]) ** 2) / len(y)), "unexcited lines"
+    seg = min(rec.n / rec.fs, max(1.0, rec.n / rec.fs / 8))
+    f, puu = scipy.signal.welch(u, rec.fs, nperseg=int(seg * rec.fs))
+    on = np.flatnonzero(puu > 1e-3 * puu[1:].max())
+    f_hi = f[on[-1]] if on.size else 0.0
+    _, pyy = scipy.signal.welch(y, rec.fs, nperseg=int(seg * rec.fs))
+    quiet = (f >= 3 * f_hi) & (f <= 0.4 * rec.fs)
+    if quiet.sum() >= 8:
+        return float(np.median(pyy[quiet]) * rec.fs / 2), "quiet band"
+    _, coh = scipy.signal.coherence(u, y, rec.fs, nperseg=int(seg * rec.fs))
+    band = np.zeros(len(f), bool)
+    band[on] = True
+    df = f[1] - f[0]
+    return float(np.sum((1 - coh[band]) * pyy[band]) * df), "coherence"
+
+
+def noise_estimate(rec: Record) -> tuple[float, str]:
+    """The record's noise floor as an NRMSE (over its output channels) and the method used (see
+    _noise_variance); never below the writer's rounding, so never zero."""
+    out, methods = [], []
+    for y in rec.outputs.values():
+        var, method = _noise_variance(rec, y)
+        out.append(max(var, _resolution_variance(y)) / np.mean(y**2))
+        methods.append(method)
+    return float(np.sqrt(np.mean(out))), methods[0]
+
+
 def noise_floor(rec: Record) -> float:
-    """Noise NRMSE of the record estimated from the data: from the scatter between periods when there are
-    two or more; otherwise from the DFT lines the input does not excite (an upper bound: distortion lands
-    there too)."""
-    out = []
-    for k, y in rec.outputs.items():
-        spp = rec.samples_per_period
-        if spp and rec.n // spp >= 2:
-            var = float(np.mean(np.var(y.reshape(-1, spp), axis=0, ddof=1)))
-        else:
-            u = next(iter(rec.inputs.values()))
-            U, Y = np.fft.rfft(u), np.fft.rfft(y)
-            quiet = np.abs(U) ** 2 < 1e-8 * np.max(np.abs(U) ** 2)
-            quiet[0] = False
-            var = float(np.mean(np.abs(Y[quiet]) ** 2) / len(y)) if quiet.any() else 0.0
-        out.append(var / np.mean(y**2))
-    return float(np.sqrt(np.mean(out)))
+    """The record's noise floor as an NRMSE (see noise_estimate)."""
+    return noise_estimate(rec)[0]
 
 
 def by_band(sim: dict, rec: Record, bands: list[tuple[float, float]]) -> list[float]:
@@ -106,14 +150,20 @@ def by_loop_region(sim: dict, rec: Record) -> dict[str, float]:
     return {r: float(np.sqrt(v)) for r, v in out.items()}
 
 
-def default_bands(records: list[Record], n: int = 8) -> list[tuple[float, float]]:
-    """n log-spaced bands over the lines the inputs excite (from 0.8x the lowest to 1.2x the highest)."""
+def excited_range(records: list[Record]) -> tuple[float, float]:
+    """Lowest and highest frequency [Hz] the records' inputs excite (DFT lines above 1e-3 of the peak)."""
     lo, hi = np.inf, 0.0
     for rec in records:
-        u = next(iter(rec.inputs.values()))
+        u = rec.compared(next(iter(rec.inputs)))
         U = np.abs(np.fft.rfft(u))
         f = np.fft.rfftfreq(len(u), 1.0 / rec.fs)
         exc = f[(U > 1e-3 * U.max()) & (f > 0)]
         lo, hi = min(lo, exc.min()), max(hi, exc.max())
+    return float(lo), float(hi)
+
+
+def default_bands(records: list[Record], n: int = 8) -> list[tuple[float, float]]:
+    """n log-spaced bands over the lines the inputs excite (from 0.8x the lowest to 1.2x the highest)."""
+    lo, hi = excited_range(records)
     edges = np.geomspace(0.8 * lo, min(1.2 * hi, records[0].fs / 2), n + 1)
     return [(float(a), float(b)) for a, b in zip(edges[:-1], edges[1:])]

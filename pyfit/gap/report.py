@@ -7,7 +7,7 @@ import pathlib
 
 import numpy as np
 
-from pyfit.analysis import plots
+from pyfit.report import plots
 from pyfit.gap import localise
 from pyfit.gap import simulate as sim
 
@@ -55,8 +55,10 @@ def nominal_gap(sims: dict, records, held, bands, cfg) -> dict:
     """The nominal model's gap (where), its noise floor from the held-out data, and whether the gap is
     significant: larger than noise_factor x the floor and than the floor + min_gap."""
     gap = _gap(sims, records, held, bands)
-    floor = _rms_over([localise.noise_floor(r) for r in held])
+    estimates = [localise.noise_estimate(r) for r in held]
+    floor = _rms_over([e[0] for e in estimates])
     gap["noise_floor"] = floor
+    gap["noise_floor_method"] = sorted({e[1] for e in estimates})
     worst = int(np.nanargmax([b["nrmse"] for b in gap["by_band"]]))
     gap["worst_band_hz"] = gap["by_band"][worst]["band_hz"]
     gap["significant"] = bool(gap["overall"] > max(cfg.noise_factor * floor, floor + cfg.min_gap))
@@ -78,15 +80,30 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
                         "wall_s": fit.wall_s})
     ranking.sort(key=lambda d: -d["score"])
     best = ranking[0] if ranking else None
-    if not significant:
+    explained_below = max(cfg.explain_factor * floor, floor + cfg.explain_margin)
+    for d in ranking:
+        d["explains"] = bool(d["shrink_pct"] >= cfg.min_shrink_pct and d["heldout_gap_after"] <= explained_below)
+    nominal_fits = nominal.calibration_nrmse <= cfg.nominal_max_nrmse
+    if not nominal_fits:
+        verdict, chosen = "nominal model does not fit", None
+    elif not significant:
         verdict, chosen = "no significant gap", None
-    elif best and best["shrink_pct"] >= cfg.min_shrink_pct:
+    elif best and best["explains"]:
         verdict, chosen = f"gap explained by {best['effect']}", best["effect"]
     else:
         verdict, chosen = "gap not explained by the candidate effects", None
     close = (len(ranking) > 1 and significant and ranking[0]["score"] - ranking[1]["score"] < cfg.close_points)
     levels = [d for d in gap["by_level"] if d["nrmse"] is not None]
     evidence = []
+    if not nominal_fits:
+        evidence = [f"the nominal model's calibration NRMSE is {nominal.calibration_nrmse:.3f} (allowed: "
+                    f"{cfg.nominal_max_nrmse}; 1.0 is the error of predicting zero): describe the system "
+                    "(--nominal FILE.toml) or check the channels and units",
+                    "nominal misfit by file: " + ", ".join(f"{d['file']}: {d['nrmse']:.3f}" for d in levels)]
+    elif significant and not chosen and best:
+        evidence = [f"best candidate {best['effect']}: held-out NRMSE {best['heldout_gap_after']:.4f}, shrink "
+                    f"{best['shrink_pct']:.1f} %; an explanation needs NRMSE <= {explained_below:.4f} (noise "
+                    f"floor {floor:.4f}) and shrink >= {cfg.min_shrink_pct:.0f} %"]
     if chosen:
         sys_effect = system.effects[chosen]
         rank_screen = sorted(screening, key=lambda k: -screening[k]).index(chosen) + 1
@@ -104,7 +121,7 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
             evidence.append("detection lines: odd misfit {:.2e} (noise {:.2e}), even misfit {:.2e} (noise {:.2e})"
                             .format(h["odd_detection"]["misfit"], h["odd_detection"]["noise"],
                                     h["even_detection"]["misfit"], h["even_detection"]["noise"]))
-    return {"verdict": verdict, "chosen_effect": chosen, "significant": significant,
+    return {"verdict": verdict, "chosen_effect": chosen, "significant": significant, "explained_below": explained_below,
             "runner_up_close": bool(close), "gap": gap, "ranking": ranking, "evidence": evidence,
             "nominal": {"params": _free_values(nominal), "calibration_nrmse": nominal.calibration_nrmse,
                         "evaluations": nominal.evaluations},
@@ -127,7 +144,8 @@ def separation(runner, result, records, fits, bands, upsample, lead_periods=1) -
         ya, yb = (sim.simulate(runner, rec, fits[e].params, upsample, lead_periods) for e in (a, b))
         if ya is None or yb is None:
             continue
-        ref = sim.Record(rec.name, rec.level, rec.level_value, rec.fs, rec.inputs, ya, rec.samples_per_period)
+        ref = sim.Record(rec.name, rec.level, rec.level_value, rec.fs, rec.inputs, ya, rec.samples_per_period,
+                         rec.weights, rec.derived, rec.first)
         band = int(np.argmax(localise.by_band(yb, ref, bands)))
         rows.append({"level": rec.level, "input_scale_of": rec.name, "difference_nrmse": localise.nrmse(yb, ref),
                      "band_hz": list(bands[band])})
@@ -171,7 +189,9 @@ def markdown(result: dict) -> str:
              f"Calibrated on {', '.join(result['calibration_files'])}; held out: "
              f"{', '.join(result['held_out_files'])}.", "",
              f"Held-out gap (NRMSE) of the nominal model: **{g['overall']:.4f}**; noise floor from the data: "
-             f"{g['noise_floor']:.4f}.", "", "## Which effect", "",
+             f"{g['noise_floor']:.4f} ({', '.join(g.get('noise_floor_method', []))}); nominal calibration NRMSE "
+             f"{result['nominal']['calibration_nrmse']:.4f}. An effect explains the gap when the held-out NRMSE with "
+             f"it is at most {result['explained_below']:.4f}.", "", "## Which effect", "",
              "| effect | score | held-out gap after | shrink [%] | screening [%] | added params | fitted |",
              "|---|---|---|---|---|---|---|"]
     for r in result["ranking"]:
@@ -181,8 +201,10 @@ def markdown(result: dict) -> str:
     if result["ranking"]:
         lines += ["", "Score = shrink − 5 points per added parameter beyond the first. "
                   "Shrink = (gap before − gap after) / (gap before − noise floor)."]
-    else:
+    elif result["verdict"] == "no significant gap":
         lines += ["", "No effect was refitted: the nominal model fits the held-out files within the noise floor."]
+    else:
+        lines += ["", "No effect was refitted: the nominal model does not fit its own calibration files."]
     if result["evidence"]:
         lines += ["", "Evidence:", ""] + [f"- {e}" for e in result["evidence"]]
     sep = result.get("separation")

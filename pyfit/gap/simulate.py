@@ -3,10 +3,11 @@ a cubic spline otherwise), outputs on the file's time grid. A periodic record is
 periods are simulated in front of it and dropped. A failed or diverging run returns None."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from pyfit.analysis import kinematics
 from pyfit.io.data import Measurement
 from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.drive import drive
@@ -23,6 +24,13 @@ class Record:
     inputs: dict  # model variable -> samples
     outputs: dict  # model variable -> samples
     samples_per_period: int  # 0: not periodic
+    weights: dict = field(default_factory=dict)  # output model variable -> weight in the fits (default 1)
+    derived: tuple = ()  # inputs derived from the recorded motion (not measured)
+    first: int = 0  # samples of a record that does not start at rest, simulated from rest but not compared
+
+    def compared(self, name: str) -> np.ndarray:
+        """An input over the samples that are compared (from `first` on)."""
+        return self.inputs[name][self.first:]
 
     @property
     def periodic(self) -> bool:
@@ -33,38 +41,71 @@ class Record:
         return len(next(iter(self.outputs.values())))
 
 
-def record_of(m: Measurement) -> Record:
-    """A Record from a measurement; periodic when its excitation says so (kind multisine, samples_per_period)."""
+def starts_at_rest(m: Measurement, samples: int = 5, fraction: float = 0.05) -> bool:
+    """Whether the record starts from rest: every output stays below `fraction` of its RMS over the first
+    `samples` samples (a response from rest grows from zero; a segment cut from a long record starts at
+    whatever phase the motion had)."""
+    return all(np.max(np.abs(v[:samples])) <= fraction * np.sqrt(np.mean(v**2))
+               for c, v in m.values.items() if c in m.outputs)
+
+
+def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> Record:
+    """A Record from a measurement; periodic when its excitation says so (kind multisine, samples_per_period).
+
+    motion: the model's displacement, velocity and acceleration inputs (e.g. x_base, v_base, a_base): the
+    ones not recorded are derived from the recorded one (pyfit.analysis.kinematics, band-limited to the
+    excited band).
+    A non-periodic record that does not start at rest (a segment cut from a long record) is simulated from
+    rest and its first transient_s seconds are not compared (the start-up transient of the simulation)."""
     exc = m.excitation or {}
     spp = int(exc.get("samples_per_period", 0)) if exc.get("kind") == "multisine" else 0
     n = len(m.t)
     if spp and n % spp:
         raise ValueError(f"{m.path}: {n} samples is not a whole number of periods of {spp} "
                          "([excitation] samples_per_period)")
+    inputs = m.by_variable("inputs")
+    derived = ()
+    if motion:
+        recorded = {kind: inputs[var] for kind, var in zip("xva", motion) if var in inputs}
+        if not recorded:
+            raise ValueError(f"{m.path.with_suffix('.toml')}: [inputs] needs the motion as one of "
+                             f"{', '.join(motion)} (model_variable), in m, mm, m/s, m/s2 or g")
+        band = kinematics.excited_band(next(iter(recorded.values())), m.sample_rate_hz)
+        full = kinematics.complete(recorded, m.sample_rate_hz, band, periodic=bool(spp))
+        derived = tuple(var for kind, var in zip("xva", motion) if var not in inputs)
+        inputs = {**inputs, **{var: full[kind] for kind, var in zip("xva", motion)}}
+    weights = {ch.model_variable: ch.weight for ch in m.outputs.values()}
+    first = 0 if spp or starts_at_rest(m) else int(round(transient_s * m.sample_rate_hz))
+    if first >= n // 2:
+        raise ValueError(f"{m.path}: the record does not start at rest and is too short to drop a "
+                         f"{transient_s:g} s transient (it has {n / m.sample_rate_hz:g} s)")
+    outputs = {k: v[first:] for k, v in m.by_variable("outputs").items()}
     return Record(m.path.stem, m.level, float(m.level_value if m.level_value is not None else 0.0),
-                  m.sample_rate_hz, m.by_variable("inputs"), m.by_variable("outputs"), spp)
+                  m.sample_rate_hz, inputs, outputs, spp, weights, derived, first)
 
 
 def scaled(rec: Record, factor: float) -> Record:
     """The same record with its inputs multiplied by factor (outputs unchanged: for predictions only)."""
     return Record(f"{rec.name}x{factor:g}", f"{rec.level} x{factor:g}", rec.level_value * factor, rec.fs,
-                  {k: v * factor for k, v in rec.inputs.items()}, rec.outputs, rec.samples_per_period)
+                  {k: v * factor for k, v in rec.inputs.items()}, rec.outputs, rec.samples_per_period, rec.weights,
+                  rec.derived, rec.first)
 
 
 def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, lead_periods: int = 1,
-             tolerance: float = 1e-8) -> dict | None:
-    """Outputs (model variable -> samples on the record's grid) for FMU parameters params; None on failure.
-    A periodic record is preceded by lead_periods simulated periods (dropped)."""
-    res = drive(runner, rec.inputs, rec.fs, list(rec.outputs), params, upsample, rec.samples_per_period,
+             tolerance: float = 1e-8, outputs=None) -> dict | None:
+    """Outputs (model variable -> samples on the record's grid; default: the record's outputs) for FMU
+    parameters params; None on failure. A periodic record is preceded by lead_periods simulated periods."""
+    res = drive(runner, rec.inputs, rec.fs, list(outputs or rec.outputs), params, upsample, rec.samples_per_period,
                 lead_periods if rec.periodic else 0, tolerance)
-    return res.values if res.ok else None
+    return {k: v[rec.first:] for k, v in res.values.items()} if res.ok else None
 
 
 def residuals(sim: dict | None, rec: Record, penalty: float = 10.0) -> np.ndarray:
-    """Stacked (y_sim - y_meas) / RMS(y_meas) / sqrt(n) per channel: its sum of squares is the sum of the
-    channels' squared NRMSE. A failed simulation gives the finite penalty vector."""
+    """Stacked sqrt(w) (y_sim - y_meas) / RMS(y_meas) / sqrt(n) per channel (w: the channel's weight, default
+    1): its sum of squares is the weighted sum of the channels' squared NRMSE. A failed simulation gives the
+    finite penalty vector."""
     parts = []
     for k, y in rec.outputs.items():
-        scale = np.sqrt(np.mean(y**2)) * np.sqrt(len(y))
+        scale = np.sqrt(np.mean(y**2)) * np.sqrt(len(y)) / np.sqrt(rec.weights.get(k, 1.0))
         parts.append(np.full(len(y), penalty / np.sqrt(len(y))) if sim is None else (sim[k] - y) / scale)
     return np.concatenate(parts)

@@ -1,5 +1,7 @@
 """The systems a diagnosis knows: FMU, nominal (linear) free parameters with their start and bounds, and
-the candidate effects of design section 6.
+the candidate effects of design section 6. The nominal model is what the user describes
+(pyfit.io.nominal.NominalModel); every dimension not described comes from the FMU's own defaults (the .mo
+files), none is written here.
 
 Effect bounds and start values follow from the data scale: sigma_y = RMS of the measured deflection of the
 nonlinear element (SDOF: y; damper: cable end relative to the clamp), sigma_v = RMS of its velocity, and
@@ -10,15 +12,18 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.signal
 
 
 @dataclass(frozen=True)
 class Scale:
-    """Data scale for bounds: element deflection RMS [m], its velocity RMS [m/s], nominal stiffness [N/m]."""
+    """Data scale for bounds: element deflection RMS [m], its velocity RMS [m/s], nominal stiffness [N/m],
+    and the nominal model's parameter values (SI) for effects that are deviations from them."""
 
     sigma_y: float
     sigma_v: float
     k: float
+    nominal: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -52,32 +57,56 @@ class System:
     stiffness: str  # the one of them that a hysteretic element's tangent stiffness replaces in part
     start: callable  # records -> start values of `linear`
     bounds: callable  # (start, softened) -> bounds of `linear`
-    scale: callable  # (records, nominal params) -> Scale
+    scale: callable  # (deflections, fs, nominal params) -> Scale
     effects: dict
     lead_periods: int = 1  # periods simulated before a periodic record (the decay of the slowest mode)
+    deflection_outputs: tuple = ()  # FMU outputs that give the nonlinear element's deflection
+    motion_inputs: tuple = ()  # displacement, velocity, acceleration inputs that must be consistent (or ())
+    deflection: callable = None  # (simulated outputs, record) -> the element's deflection [m]
 
 
 def _sym(scale_fn):
     return lambda s: (-scale_fn(s), 0.0, scale_fn(s))
 
 
-def _first(rec, kind):
-    return next(iter(getattr(rec, kind).values()))
-
-
 # ---- SDOF --------------------------------------------------------------------------------------------------
-def sdof_start(records) -> dict:
-    """m, c, k of a linear SDOF from the measured FRF (input -> output DFT lines the input excites):
-    1/H = k - w^2 m + i w c, solved by least squares weighted by |H| (relative error)."""
-    rows, rhs = [], []
-    for rec in records:
-        u, y = _first(rec, "inputs"), _first(rec, "outputs")
+OUTPUT_ORDER = {"y": 0, "v": 1, "a": 2}  # SDOF outputs: displacement, velocity, acceleration
+
+
+def _frf_lines(rec, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(ω [rad/s], H of the displacement, weight) on the lines the input excites. Whole periods: the DFT lines
+    (exact, no leakage). Otherwise the H1 estimate S_uy/S_uu from Welch segments (noise on the output averages
+    out), on the bins where the input has power and the coherence is above 0.5, weighted by the coherence."""
+    u, y = rec.compared(next(iter(rec.inputs))), rec.outputs[name]
+    if rec.samples_per_period:
         U, Y = np.fft.rfft(u), np.fft.rfft(y)
         w = 2 * np.pi * np.fft.rfftfreq(len(u), 1.0 / rec.fs)
         ex = (np.abs(U) > 1e-3 * np.abs(U).max()) & (w > 0)
-        G = U[ex] / Y[ex]  # 1/H
-        wt = 1.0 / np.abs(G)
-        rows += [np.column_stack([-w[ex] ** 2 * wt, 0 * wt, wt]), np.column_stack([0 * wt, w[ex] * wt, 0 * wt])]
+        H, weight = Y[ex] / U[ex], np.ones(int(ex.sum()))
+    else:
+        seg = int(min(len(u), max(rec.fs, len(u) // 8)))
+        f, suu = scipy.signal.welch(u, rec.fs, nperseg=seg)
+        _, suy = scipy.signal.csd(u, y, rec.fs, nperseg=seg)
+        _, coh = scipy.signal.coherence(u, y, rec.fs, nperseg=seg)
+        w = 2 * np.pi * f
+        ex = (suu > 1e-3 * suu[1:].max()) & (w > 0) & (coh > 0.5)
+        H, weight = suy[ex] / suu[ex], coh[ex]
+    return w[ex], H / (1j * w[ex]) ** OUTPUT_ORDER[name], weight
+
+
+def sdof_start(records) -> dict:
+    """m, c, k of a linear SDOF from the measured FRF (the output converted to displacement: /(iω) per time
+    derivative): 1/H = k - ω²m + iωc, solved by least squares weighted by |H| (relative error) and by the
+    coherence; any recorded input, sweeps and noise as well as multisines."""
+    rows, rhs = [], []
+    for rec in records:
+        name = next((k for k in rec.outputs if k in OUTPUT_ORDER), None)
+        if name is None:
+            raise ValueError(f"{rec.name}: the SDOF start needs an output y, v or a; outputs: {', '.join(rec.outputs)}")
+        w, H, weight = _frf_lines(rec, name)
+        G = 1.0 / H
+        wt = weight * np.abs(H)
+        rows += [np.column_stack([-w ** 2 * wt, 0 * wt, wt]), np.column_stack([0 * wt, w * wt, 0 * wt])]
         rhs += [G.real * wt, G.imag * wt]
     m, c, k = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
     return {"m": float(abs(m)), "c": float(abs(c)), "k": float(abs(k))}
@@ -89,11 +118,20 @@ def sdof_bounds(start: dict, softened: bool = False) -> dict:
             "k": ((0.05 if softened else 0.5) * start["k"], 2.0 * start["k"])}
 
 
-def sdof_scale(records, params) -> Scale:
-    """RMS of the measured displacement and of its velocity; k of the nominal fit."""
-    y = np.concatenate([_first(r, "outputs") for r in records])
-    v = np.concatenate([np.gradient(_first(r, "outputs")) * r.fs for r in records])
-    return Scale(float(np.sqrt(np.mean(y**2))), float(np.sqrt(np.mean(v**2))), params["k"])
+def deflection_scale(deflections: list[np.ndarray], fs: float, k: float, params: dict) -> Scale:
+    """RMS of the nonlinear element's deflection (simulated by the calibrated nominal model from the measured
+    inputs, whatever the sensors were) and of its rate; the stiffness k."""
+    y = np.concatenate(deflections)
+    v = np.concatenate([np.gradient(d) * fs for d in deflections])
+    return Scale(float(np.sqrt(np.mean(y**2))), float(np.sqrt(np.mean(v**2))), k, dict(params))
+
+
+def sdof_deflection(sim: dict, rec) -> np.ndarray:
+    return sim["y"]
+
+
+def sdof_stiffness(params: dict) -> float:
+    return params["k"]
 
 
 SDOF_EFFECTS = {
@@ -118,23 +156,21 @@ SDOF_EFFECTS = {
 }
 
 # ---- Stockbridge damper ------------------------------------------------------------------------------------
-DAMPER_DESIGN = {"EI": 10.0, "alpha_pd": 2.0, "beta_pd": 2e-4}  # design 1.3 values: the nominal's start
-DAMPER_L1 = 0.17  # m, cable length clamp - mass 1
-
-
 def damper_bounds(start: dict, softened: bool = False) -> dict:
-    """Bounds of EI, alpha_pd, beta_pd around their start."""
+    """Default bounds of EI, alpha_pd, beta_pd around their start."""
     return {"EI": ((0.1 if softened else 0.3) * start["EI"], 3.0 * start["EI"]),
             "alpha_pd": (0.1 * start["alpha_pd"], 10.0 * start["alpha_pd"]),
             "beta_pd": (0.1 * start["beta_pd"], 10.0 * start["beta_pd"])}
 
 
-def damper_scale(records, params) -> Scale:
-    """RMS of the cable-end deflection relative to the clamp (x1 - x_base) and of its velocity; k = 3 EI/L1^3,
-    the tip stiffness of arm 1."""
-    r = np.concatenate([rec.outputs["x1"] - rec.inputs["x_base"] for rec in records])
-    v = np.concatenate([np.gradient(rec.outputs["x1"] - rec.inputs["x_base"]) * rec.fs for rec in records])
-    return Scale(float(np.sqrt(np.mean(r**2))), float(np.sqrt(np.mean(v**2))), 3 * params["EI"] / DAMPER_L1**3)
+def damper_deflection(sim: dict, rec) -> np.ndarray:
+    """Cable end 1 relative to the clamp [m]."""
+    return sim["x1"] - rec.compared("x_base")
+
+
+def damper_stiffness(params: dict) -> float:
+    """3 EI / L1^3 [N/m], the tip stiffness of arm 1 (EI and L1 of the nominal model)."""
+    return 3 * params["EI"] / params["L1"] ** 3
 
 
 def _pair(name1, name2, rng):
@@ -157,24 +193,77 @@ DAMPER_EFFECTS = {
     "quadratic_damping": Effect(
         "quadratic_damping", _pair("c2_1", "c2_2", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y / s.sigma_v**2)),
         signature="damping that grows with amplitude (largest misfit at the highest level)"),
-    "mass_eccentricity": Effect(
-        "mass_eccentricity", _pair("a1", "a2", lambda s: (-0.06, 0.0, 0.06)),
+    "mass_eccentricity": Effect(  # a deviation of the mass offsets from the nominal's, up to 30 mm
+        "mass_eccentricity", (Param("a1", lambda s: (s.nominal["a1"] - 0.03, s.nominal["a1"], s.nominal["a1"] + 0.03)),
+                              Param("a2", lambda s: (s.nominal["a2"] - 0.03, s.nominal["a2"], s.nominal["a2"] + 0.03))),
         signature="amplitude-independent shift of the modes (the same misfit at every level)"),
 }
 
-SYSTEMS = {
-    "sdof": System("sdof", "SDOFBoucWen", {"exc_type": 0, "alpha": 0.0, "k3": 0.0, "F_c": 0.0, "c2": 0.0},
-                   ("m", "c", "k"), "k", sdof_start, sdof_bounds, sdof_scale, SDOF_EFFECTS),
-    "damper": System("damper", "StockbridgeDamper",
-                     {"exc_type": 0, "k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "F_c1": 0.0,
-                      "F_c2": 0.0, "c2_1": 0.0, "c2_2": 0.0, "a1": 0.0, "a2": 0.0},
-                     ("EI", "alpha_pd", "beta_pd"), "EI", lambda records: dict(DAMPER_DESIGN), damper_bounds,
-                     damper_scale, DAMPER_EFFECTS, lead_periods=2),
+@dataclass(frozen=True)
+class _Family:
+    fmu: str
+    switches: dict  # FMU parameters that switch every candidate effect off
+    linear: tuple  # the default uncertain parameters
+    stiffness: str
+    data_start: callable | None  # records -> start values from the data (None: the FMU's defaults)
+    bounds: callable
+    stiffness_of: callable  # params -> the nonlinear element's nominal stiffness [N/m]
+    deflection: callable  # (simulated outputs, record) -> the element's deflection [m]
+    deflection_outputs: tuple
+    motion_inputs: tuple
+    effects: dict
+    lead_periods: int
+
+
+FAMILY = {
+    "sdof": _Family("SDOFBoucWen", {"exc_type": 0, "alpha": 0.0, "k3": 0.0, "F_c": 0.0, "c2": 0.0},
+                    ("m", "c", "k"), "k", sdof_start, sdof_bounds, sdof_stiffness, sdof_deflection, ("y",), (),
+                    SDOF_EFFECTS, 1),
+    "damper": _Family("StockbridgeDamper",
+                      {"exc_type": 0, "k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "F_c1": 0.0,
+                       "F_c2": 0.0, "c2_1": 0.0, "c2_2": 0.0},
+                      ("EI", "alpha_pd", "beta_pd"), "EI", None, damper_bounds, damper_stiffness, damper_deflection,
+                      ("x1",), ("x_base", "v_base", "a_base"), DAMPER_EFFECTS, 2),
 }
 
 
-def get_system(name: str) -> System:
-    """The System called name; a clear error listing the known ones otherwise."""
-    if name not in SYSTEMS:
-        raise ValueError(f"--model '{name}' unknown; allowed: {', '.join(SYSTEMS)}")
-    return SYSTEMS[name]
+def family_fmu(name: str) -> str:
+    """The FMU a family's diagnosis runs; a clear error listing the known families otherwise."""
+    if name not in FAMILY:
+        raise ValueError(f"--model '{name}' unknown; allowed: {', '.join(FAMILY)}")
+    return FAMILY[name].fmu
+
+
+def make_system(name: str, defaults: dict, nominal=None) -> System:
+    """The System of family `name` for a nominal model (pyfit.io.nominal.NominalModel, or None for the FMU's
+    own defaults). defaults: the FMU's parameter start values (name -> value)."""
+    fam = FAMILY[name]
+    fixed = dict(nominal.fixed) if nominal else {}
+    values = {**defaults, **fixed}
+    free = dict(nominal.free) if nominal and nominal.free else {}
+    linear = tuple(free) or fam.linear
+    given = {n: p.start for n, p in free.items() if p.start is not None}
+
+    def start(records) -> dict:
+        from_data = fam.data_start(records) if fam.data_start else {}
+        return {n: given.get(n, from_data.get(n, values[n])) for n in linear}
+
+    def bounds(st: dict, softened: bool = False) -> dict:
+        rule = fam.bounds({**values, **st}, softened)
+        out = {}
+        for n in linear:
+            p = free.get(n)
+            if p is not None and p.lower is not None:
+                out[n] = (p.lower, p.upper)
+            elif n in rule:
+                out[n] = rule[n]
+            else:  # an uncertain parameter without bounds: a factor 3 either way around its start
+                out[n] = tuple(sorted((st[n] / 3.0, st[n] * 3.0)))
+        return out
+
+    def scale(deflections: list[np.ndarray], fs: float, params: dict) -> Scale:
+        p = {**values, **params}
+        return deflection_scale(deflections, fs, fam.stiffness_of(p), p)
+
+    return System(name, fam.fmu, {**fam.switches, **fixed}, linear, fam.stiffness, start, bounds, scale,
+                  fam.effects, fam.lead_periods, fam.deflection_outputs, fam.motion_inputs, fam.deflection)

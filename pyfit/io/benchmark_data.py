@@ -17,7 +17,7 @@ from pyfit.runtime.drive import drive
 FS_HZ = 750.0  # sampling frequency of the official signals (not stored in the files)
 # ../shared/data/boucwen beside the repository, or the folder named by BOUCWEN_DATA_DIR
 DEFAULT_DIR = pathlib.Path(os.environ.get("BOUCWEN_DATA_DIR")
-                           or pathlib.Path(__file__).resolve().parents[2] / "shared" / "data" / "boucwen")
+                           or pathlib.Path(__file__).resolve().parents[3] / "shared" / "data" / "boucwen")
 
 
 @dataclass

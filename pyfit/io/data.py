@@ -119,6 +119,10 @@ def check_time(t: np.ndarray, fs: float, csv_path, side, column: str, first_row:
     """A time column [s] must be the uniform grid of fs within MAX_TIME_SLIP samples (rounding allowed)."""
     if len(t) < 2:
         raise MeasurementError(f"{csv_path}: fewer than two samples")
+    bad = np.flatnonzero(~np.isfinite(t))
+    if bad.size:
+        raise MeasurementError(f"{csv_path}: row {first_row + bad[0]}: column '{column}' is not finite; allowed: "
+                               "finite times in s (or time_unit)")
     dt = np.diff(t)
     bad = np.flatnonzero(dt <= 0)
     if bad.size:

@@ -245,7 +245,7 @@ def check_trajectories(name: str, fmu: pathlib.Path, out_dir: pathlib.Path | Non
 
 
 def _overlay(path, t, want, res, outputs, name, label, units):
-    from pyfit.analysis import plots
+    from pyfit.report import plots
 
     plots.time_histories(path, [("CasADi reference (CVODES)", t, want), ("FMU (co-simulation)", t, res.values)],
                          outputs, units, f"{name}: {label}")

@@ -76,7 +76,7 @@ def sdof() -> ReferenceModel:
     zdot = bouc_wen_rate(v, z, P["alpha"], P["beta"], P["gamma"], P["delta"], P["nu"])
     x = ca.vertcat(y, v, z)
     return ReferenceModel("SDOFBoucWen", 1, 1, x, u, p, t, ca.vertcat(v, acc, zdot),
-                          {"y": y, "v": v, "z": z}, names, ["u"], dict(SDOF_DEFAULTS))
+                          {"y": y, "v": v, "z": z, "a": acc}, names, ["u"], dict(SDOF_DEFAULTS))
 
 
 def two_dof(config: str) -> ReferenceModel:
@@ -159,7 +159,9 @@ def damper() -> ReferenceModel:
     F_clamp = P["m_c"] * ac + T_full.T @ M @ q_full_dd
     x = ca.vertcat(q, qd, z)
     outputs = {"x1": q[0], "x2": q[2], "phi1": q[1], "phi2": q[3],
-               "xg1": q[0] - P["a1"] * q[1], "xg2": q[2] + P["a2"] * q[3], "F_clamp": F_clamp}
+               "xg1": q[0] - P["a1"] * q[1], "xg2": q[2] + P["a2"] * q[3], "F_clamp": F_clamp,
+               "acc_x1": qdd[0], "acc_x2": qdd[2], "acc_xg1": qdd[0] - P["a1"] * qdd[1],
+               "acc_xg2": qdd[2] + P["a2"] * qdd[3]}
     return ReferenceModel("StockbridgeDamper", 4, 2, x, ca.vertcat(xc, vc, ac), p, t,
                           ca.vertcat(qd, qdd, *zdot), outputs, names, ["x_base", "v_base", "a_base"],
                           dict(DAMPER_DEFAULTS))

@@ -25,7 +25,8 @@ from pyfit.reference import integrate
 from pyfit.reference import models
 
 UNITS = {"y": "m", "y1": "m", "y2": "m", "x1": "m", "x2": "m", "xg1": "m", "xg2": "m", "F_clamp": "N",
-         "z": "N", "v": "m/s", "v1": "m/s", "v2": "m/s", "phi1": "rad", "phi2": "rad"}
+         "z": "N", "v": "m/s", "v1": "m/s", "v2": "m/s", "phi1": "rad", "phi2": "rad",
+         "a": "m/s2", "acc_x1": "m/s2", "acc_x2": "m/s2", "acc_xg1": "m/s2", "acc_xg2": "m/s2"}
 
 
 @dataclass

@@ -21,7 +21,7 @@ def ensure_fmu(name: str, fmu_dir: pathlib.Path) -> pathlib.Path:
 def run_example(name: str, params: dict, stop: float | None, interval: float, fmu_dir: pathlib.Path,
                 out_dir: pathlib.Path) -> tuple[pathlib.Path, pathlib.Path]:
     """Simulate the example (co-simulation) and write <out>/<name>.csv and <out>/<name>.png."""
-    from pyfit.analysis import plots
+    from pyfit.report import plots
 
     path = ensure_fmu(name, fmu_dir)
     md = read_model_description(str(path))

@@ -162,10 +162,12 @@ class FmuRunner:
     def simulate(self, stop_time: float, output_interval: float, outputs: list[str],
                  params: dict | None = None, inputs: dict[str, np.ndarray] | None = None,
                  input_time: np.ndarray | None = None, tolerance: float = 1e-8,
-                 start_time: float = 0.0) -> SimulationResult:
+                 start_time: float = 0.0, hold_inputs: bool = False) -> SimulationResult:
         """Simulate from start_time to stop_time; outputs sampled every output_interval (uniform grid).
 
-        inputs: name -> samples at input_time (linear in between). A failing or diverging run returns
+        inputs: name -> samples at input_time (linear in between, sent with their slopes as input derivatives;
+        hold_inputs=True holds each communication point's value over the step instead, as importers without
+        input derivatives do). A failing or diverging run returns
         SimulationResult(ok=False) with the reason; invalid parameter names raise ParameterError.
         """
         params = dict(params or {})
@@ -185,7 +187,7 @@ class FmuRunner:
             self._state["log"].clear()
             fmu.reset()
             if self.interface == "CoSimulation":
-                vals = self._run_cs(fmu, time, outputs, params, inputs, input_time, tolerance)
+                vals = self._run_cs(fmu, time, outputs, params, inputs, input_time, tolerance, hold_inputs)
             else:
                 vals = self._run_me(fmu, time, outputs, params, inputs, input_time, tolerance)
         except (FMICallException, OSError, RuntimeError) as exc:
@@ -197,7 +199,7 @@ class FmuRunner:
         assert np.allclose(dt, output_interval, rtol=1e-9, atol=0), "output grid is not uniform"
         return SimulationResult(time, vals)
 
-    def _run_cs(self, fmu, time, outputs, params, inputs, input_time, tolerance):
+    def _run_cs(self, fmu, time, outputs, params, inputs, input_time, tolerance, hold_inputs=False):
         fmu.setupExperiment(tolerance=tolerance, startTime=time[0])
         self.set_parameters(fmu, params)
         fmu.enterInitializationMode()
@@ -231,7 +233,7 @@ class FmuRunner:
             get_real(comp, out_vr, len(outputs), out_buf)
             result[i] = out_buf[:]
             if i + 1 < len(time):
-                if k:
+                if k and not hold_inputs:
                     der_buf[:] = slope[:, i]
                     set_der(comp, in_vr, k, order, der_buf)
                 do_step(comp, t, time[i + 1] - t, 1)

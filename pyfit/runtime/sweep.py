@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from fmpy import read_model_description
 
-from pyfit.analysis import plots
+from pyfit.report import plots
 from pyfit.analysis import signals
 from pyfit.runtime.batch import RunSpec, run_batch
 from pyfit.io.sweep_config import SweepConfig

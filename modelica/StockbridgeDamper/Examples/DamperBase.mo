@@ -45,6 +45,10 @@ partial model DamperBase "Stockbridge damper on a shaker (design 1.3): 6-DOF Eul
   output Real x_clamp(unit="m") "Clamp displacement (input plus built-in motion)";
   output Real v_clamp(unit="m/s") "Clamp velocity";
   output Real a_clamp(unit="m/s2") "Clamp acceleration";
+  output Real acc_x1(unit="m/s2") "Vertical acceleration of the cable end at mass 1 (an accelerometer there)";
+  output Real acc_x2(unit="m/s2") "Vertical acceleration of the cable end at mass 2";
+  output Real acc_xg1(unit="m/s2") "Vertical acceleration of the centre of mass 1 (an accelerometer on the mass)";
+  output Real acc_xg2(unit="m/s2") "Vertical acceleration of the centre of mass 2";
   Components.EccentricMass mass1(m=m1, J_G=J_G1, a=a1, side=-1, alpha_pd=alpha_pd) "End mass 1 (at the -axial end)";
   Components.EccentricMass mass2(m=m2, J_G=J_G2, a=a2, side=1, alpha_pd=alpha_pd) "End mass 2 (at the +axial end)";
   Components.Clamp clamp(m=m_c, J=J_GC) "Clamp body";
@@ -102,4 +106,8 @@ equation
   x_clamp = clamp.x;
   v_clamp = clamp.v;
   a_clamp = clamp.acc;
+  acc_x1 = mass1.acc;
+  acc_x2 = mass2.acc;
+  acc_xg1 = mass1.acc - a1*mass1.alp;
+  acc_xg2 = mass2.acc + a2*mass2.alp;
 end DamperBase;

@@ -16,6 +16,7 @@ model SDOFBoucWen "Bouc-Wen benchmark oscillator (Noel-Schoukens): m*y'' + c*y' 
   input Real u(unit="N", start=0) "External force on the mass (added to the built-in excitation)";
   output Real y(unit="m") "Displacement of the mass";
   output Real v(unit="m/s") "Velocity of the mass";
+  output Real a(unit="m/s2") "Acceleration of the mass";
   output Real z(unit="N") "Bouc-Wen hysteretic force";
   output Real F(unit="N") "Total force applied to the mass (input plus built-in excitation)";
   Components.Mass mass(m=m) "Oscillating mass";
@@ -41,6 +42,7 @@ equation
   connect(fixed.flange, quadraticDamper.flange_a);
   y = mass.s;
   v = mass.v;
+  a = der(mass.v);
   z = boucWen.z;
   F = force.u;
   annotation(experiment(StartTime=0, StopTime=120, Interval=1e-3, Tolerance=1e-8));
