@@ -2,7 +2,8 @@
 explains it, and how far the misfit shrinks on held-out files once that effect is added.
 
     python scripts/diagnose.py --model sdof|damper --data DATASET_DIR [--nominal FILE.toml] [--config FILE.toml] [--out DIR]
-    python scripts/diagnose.py --make-datasets DIR [--seeds 0 1 2]   # the withheld-effect test cases
+    python scripts/diagnose.py --make-datasets DIR [--seeds 0 1 2] [--excitation sweep] [--record a] [--motion x]
+                                                                     # the withheld-effect test cases
     python scripts/diagnose.py --benchmark --config configs/diagnose_benchmark.toml   # official Bouc-Wen data
     python scripts/diagnose.py --cases DIR [--out DIR]   # every dataset under DIR, with summary.md
 """
@@ -17,6 +18,7 @@ from pyfit.io import benchmark_data  # noqa: E402
 from pyfit.gap import cases  # noqa: E402
 from pyfit.gap import datasets  # noqa: E402
 from pyfit.gap.diagnose import diagnose, load_config  # noqa: E402
+from pyfit.io.nominal import load_nominal  # noqa: E402
 from pyfit.io.schema import ConfigError  # noqa: E402
 
 
@@ -35,10 +37,18 @@ def main() -> int:
                     help="use the official Bouc-Wen benchmark signals (written as a dataset into OUT/data)")
     ap.add_argument("--cases", metavar="DIR", help="diagnose every dataset folder under DIR and write summary.md")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2], help="noise seeds of the null cases")
+    ap.add_argument("--excitation", choices=["multisine", "sweep"], default="multisine",
+                    help="with --make-datasets: steady multisine periods, or a 35 s sweep from rest")
+    ap.add_argument("--record", nargs="+", metavar="OUTPUT", help="with --make-datasets: the outputs recorded "
+                    "(default: displacements; e.g. a, or acc_x1 acc_x2)")
+    ap.add_argument("--motion", default="xva", help="with --make-datasets --model damper: which of the clamp's "
+                                                    "x, v, a are recorded (e.g. x)")
     args = ap.parse_args()
     try:
         if args.make_datasets:
-            for path in datasets.write_cases(args.make_datasets, args.model, args.seeds):
+            style = datasets.LabStyle(args.excitation, tuple(args.record) if args.record else None, args.motion)
+            base = load_nominal(args.nominal).parameters() if args.nominal else None
+            for path in datasets.write_cases(args.make_datasets, args.model, args.seeds, style=style, base=base):
                 print(path)
             return 0
         cfg = load_config(args.config) if args.config else None

@@ -14,6 +14,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from pyfit.design import energy_balance as eb  # noqa: E402
+from pyfit.io.nominal import load_nominal  # noqa: E402
 from pyfit.runtime.fmu import FmuRunner  # noqa: E402
 from pyfit.runtime.examples import ensure_fmu  # noqa: E402
 
@@ -29,6 +30,7 @@ def main() -> int:
     ap.add_argument("--amplitudes", type=float, nargs=3, default=[1e-5, 3e-2, 12], metavar=("MIN", "MAX", "N"),
                     help="clamp amplitude grid of the damper power table [m] (log-spaced)")
     ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE", help="damper FMU parameters")
+    ap.add_argument("--nominal", help="TOML describing your damper ([nominal] fixed and free parameters; --set wins)")
     ap.add_argument("--turbulence", type=float, default=0.0, help="turbulence intensity I_v [-] (0: smooth flow)")
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument("--fmus", default="fmus")
@@ -36,7 +38,8 @@ def main() -> int:
     args = ap.parse_args()
     fmus = pathlib.Path(args.fmus)
     span = FmuRunner(str(ensure_fmu("ConductorSpan", fmus)))
-    params = {k: float(v) for k, v in (s.split("=", 1) for s in args.set)}
+    params = {**(load_nominal(args.nominal).parameters() if args.nominal else {}),
+              **{k: float(v) for k, v in (s.split("=", 1) for s in args.set)}}
     first, last, step = args.freqs
     freqs = np.arange(first, last + step / 2, step)
     amps = np.geomspace(args.amplitudes[0], args.amplitudes[1], int(args.amplitudes[2]))

@@ -12,6 +12,7 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
+from pyfit.io.nominal import load_nominal  # noqa: E402
 from pyfit.io.schema import ConfigError  # noqa: E402
 from pyfit.fit.batch import describe_run, fit_batch  # noqa: E402
 
@@ -26,11 +27,12 @@ def main() -> int:
     ap.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
     ap.add_argument("--out", default="results/fit", help="output folder")
     ap.add_argument("--fmus", default="fmus", help="folder with the FMUs (built if missing)")
+    ap.add_argument("--nominal", help="TOML describing your system ([nominal] fixed and free parameters)")
     args = ap.parse_args()
     configs = [pathlib.Path(c) for c in (args.configs or [DEFAULT])]
     try:
         results = fit_batch(configs, args.repeats, pathlib.Path(args.out), pathlib.Path(args.fmus), args.workers,
-                            args.scheduler)
+                            args.scheduler, nominal=load_nominal(args.nominal) if args.nominal else None)
     except (ConfigError, FileNotFoundError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -8,6 +8,7 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
+from pyfit.io.nominal import load_nominal  # noqa: E402
 from pyfit.io.sweep_config import ConfigError, load_sweep  # noqa: E402
 from pyfit.runtime.examples import ensure_fmu  # noqa: E402
 from pyfit.runtime.sweep import fmu_interface, run_study  # noqa: E402
@@ -20,10 +21,12 @@ def main() -> int:
     ap.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
     ap.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
     ap.add_argument("--fmus", default="fmus", help="folder with the FMUs (built if missing)")
+    ap.add_argument("--nominal", help="TOML describing your system ([nominal] fixed and free parameters)")
     args = ap.parse_args()
     fmus = pathlib.Path(args.fmus)
     try:
-        cfg = load_sweep(args.config, lambda m: fmu_interface(ensure_fmu(m, fmus)))
+        cfg = load_sweep(args.config, lambda m: fmu_interface(ensure_fmu(m, fmus)),
+                         load_nominal(args.nominal) if args.nominal else None)
         out = pathlib.Path(args.out or f"results/{cfg.path.stem}")
         rows = run_study(cfg, fmus, out, args.workers, args.scheduler)
     except (ConfigError, ValueError) as exc:

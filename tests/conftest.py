@@ -58,15 +58,33 @@ def _fmt(x: float) -> str:
     return f"{x:.3g}" if x != 0 else "0"
 
 
-def pytest_sessionfinish(session, exitstatus):
-    """Write the measured figures of this run (only after a run where every test passed)."""
-    if not _MEASURED or exitstatus != 0:
-        return
+def _table(rows: list[dict]) -> str:
     lines = ["| check | measured | allowed | test |", "|---|---|---|---|"]
-    for m in _MEASURED:
+    for m in rows:
         test = m["test"].split("::", 1)
         check = m["check"].replace("|", "\\|")
         lines.append(f"| {check} | {_fmt(m['value'])} | {'≥' if m['at_least'] else '≤'} {_fmt(m['bar'])} | "
                      f"`{test[0].removeprefix('tests/')}::{test[1]}` |")
+    return "\n".join(lines) + "\n"
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """Write the measured figures of a run in which every test passed: with pytest-xdist each worker leaves its
+    rows in a JSON file and the controller writes the table, ordered by test file and name."""
+    import json
+
+    worker = getattr(session.config, "workerinput", None)
+    parts = MEASURED_TABLE.parent / "tests_parts"
+    if worker is not None:
+        parts.mkdir(parents=True, exist_ok=True)
+        (parts / f"{worker['workerid']}.json").write_text(json.dumps(_MEASURED))
+        return
+    rows = list(_MEASURED)
+    if parts.is_dir():
+        for f in sorted(parts.glob("*.json")):
+            rows += json.loads(f.read_text())
+            f.unlink()
+    if not rows or exitstatus != 0:
+        return
     MEASURED_TABLE.parent.mkdir(parents=True, exist_ok=True)
-    MEASURED_TABLE.write_text("\n".join(lines) + "\n")
+    MEASURED_TABLE.write_text(_table(sorted(rows, key=lambda m: (m["test"].split("::")[0], m["test"]))))

@@ -42,6 +42,12 @@ def test_rounded_time_comments_and_extra_columns_are_read(tmp_path):
     assert set(m.values) == {"x_mm", "F_kN"}  # the text column and the temperature are never parsed
 
 
+def test_tab_separated_export_is_read(tmp_path):
+    m = read_measurement(lab_file(tmp_path, sep="\t"))
+    t = np.arange(N) / FS
+    assert np.max(np.abs(m.values["x_mm"] - 2e-3 * np.sin(2 * np.pi * 13 * t))) < 1e-10
+
+
 def test_absent_time_column_uses_the_sidecar_rate(tmp_path):
     m = read_measurement(lab_file(tmp_path, time=False))
     assert m.t[0] == 0.0 and m.t[-1] == pytest.approx((N - 1) / FS, rel=1e-14)

@@ -23,10 +23,11 @@ def run_dir(out: pathlib.Path, config: pathlib.Path, seed: int) -> pathlib.Path:
 
 
 def _task(task):
-    """One fit in a worker: (config path, seed, fmu dir, out dir, GA stop value) -> result summary or the error."""
-    config, seed, fmu_dir, out, stop_at = task
+    """One fit in a worker: (config path, seed, fmu dir, out dir, GA stop value, nominal) -> result summary or
+    the error."""
+    config, seed, fmu_dir, out, stop_at, nominal = task
     try:
-        cfg = load_fit(config, _parameters_of(fmu_dir))
+        cfg = load_fit(config, _parameters_of(fmu_dir), nominal)
         result = run_fit(cfg, fmu_dir, run_dir(out, config, seed), seed, stop_at)
         return {k: v for k, v in result.items() if k not in ("history", "config_text")}
     except Exception as exc:  # one failing fit does not stop the batch
@@ -35,10 +36,12 @@ def _task(task):
 
 
 def fit_batch(configs: list[pathlib.Path], repeats: int, out: pathlib.Path, fmu_dir: pathlib.Path,
-              workers: int | None = None, scheduler=None, progress: bool = True, first_seed: int = 0) -> list[dict]:
-    """Run every config x seed not finished yet (a result.json marks a finished run); write summary.md."""
+              workers: int | None = None, scheduler=None, progress: bool = True, first_seed: int = 0,
+              nominal=None) -> list[dict]:
+    """Run every config x seed not finished yet (a result.json marks a finished run); write summary.md.
+    nominal: a described system (pyfit.io.nominal.NominalModel) whose parameters every fit keeps fixed."""
     configs = [pathlib.Path(c) for c in configs]
-    cfgs = [load_fit(c, _parameters_of(fmu_dir)) for c in configs]  # validate all before running any
+    cfgs = [load_fit(c, _parameters_of(fmu_dir), nominal) for c in configs]  # validate all before running any
     for cfg in cfgs:
         ensure_target(cfg)  # made once here, not raced by the workers
     for cfg in cfgs:
@@ -57,7 +60,7 @@ def fit_batch(configs: list[pathlib.Path], repeats: int, out: pathlib.Path, fmu_
                     r = json.loads(f.read_text())
                     results.append({k: v for k, v in r.items() if k not in ("history", "config_text")})
                 else:
-                    tasks.append((c, seed, fmu_dir, out, stop_at))
+                    tasks.append((c, seed, fmu_dir, out, stop_at, nominal))
         results += map_tasks(_task, tasks, workers, scheduler, progress, "fits")
     out.mkdir(parents=True, exist_ok=True)
     (out / "summary.md").write_text(summary_markdown(results))

@@ -3,9 +3,10 @@ the candidate effects of design section 6. The nominal model is what the user de
 (pyfit.io.nominal.NominalModel); every dimension not described comes from the FMU's own defaults (the .mo
 files), none is written here.
 
-Effect bounds and start values follow from the data scale: sigma_y = RMS of the measured deflection of the
-nonlinear element (SDOF: y; damper: cable end relative to the clamp), sigma_v = RMS of its velocity, and
-the nominal stiffness k of that element (SI units throughout).
+Effect bounds and start values follow from the data scale: sigma_y = RMS of the deflection of the nonlinear
+element (SDOF: y; damper: cable end relative to the clamp) as the calibrated nominal model simulates it from
+the measured inputs (whatever the sensors were), sigma_v = RMS of its rate, and the nominal stiffness k of
+that element (SI units throughout).
 """
 from __future__ import annotations
 
@@ -52,7 +53,7 @@ class System:
 
     name: str
     fmu: str
-    nominal_fixed: dict  # switches that make the FMU the nominal model
+    nominal_fixed: dict  # switches that make the FMU the nominal model, and the described known parameters
     linear: tuple  # the nominal model's free parameters
     stiffness: str  # the one of them that a hysteretic element's tangent stiffness replaces in part
     start: callable  # records -> start values of `linear`

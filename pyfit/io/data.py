@@ -4,7 +4,8 @@ Sidecar keys: model, sample_rate_hz, [inputs] and [outputs] mapping column -> {u
 optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s" or "ms").
 
 The reader takes files as lab software writes them, wherever that is still unambiguous:
-- `#` comment lines before the header, quoted column names, extra columns (never parsed);
+- `#` comment lines before the header, quoted column names, ',' or tab between columns, extra columns
+  (never parsed);
 - a time column rounded to as few as 6 significant digits, or none at all (then sample_rate_hz gives the
   time); the samples are put on the exact grid t0 + k/fs;
 - units converted to SI on reading (see TO_SI).
@@ -83,31 +84,33 @@ def _channels(side, table, section) -> dict[str, Channel]:
     return out
 
 
-def _header(csv_path: pathlib.Path) -> tuple[list[str], int]:
-    """Column names and the number of lines before the data (comment lines and the header)."""
+def _header(csv_path: pathlib.Path) -> tuple[list[str], int, str]:
+    """Column names, the number of lines before the data (comment lines and the header) and the delimiter
+    (',' or a tab)."""
     with open(csv_path, encoding="utf-8-sig") as f:
         for skip, line in enumerate(f, 1):
             if line.strip() and not line.lstrip().startswith("#"):
                 break
         else:
             raise MeasurementError(f"{csv_path}: no header line (only comments or empty)")
-        first = next(f, "")
-    if ";" in line and "," not in line:
+        first = next((ln for ln in f if ln.strip() and not ln.lstrip().startswith("#")), "")
+    delimiter = "," if "," in line or "\t" not in line else "\t"
+    if ";" in line and delimiter not in line:
         raise MeasurementError(f"{csv_path}: row {skip}: columns are separated by ';' (a decimal-comma export); "
                                "allowed: ',' between columns and '.' as the decimal mark (export as CSV with a "
                                "point decimal separator)")
-    names = [h.strip().strip('"').strip("'") for h in line.strip().split(",")]
-    if first.strip() and len(first.strip().split(",")) != len(names):
-        hint = " (decimal commas? use '.' as the decimal mark)" if len(first.strip().split(",")) > len(names) else ""
-        raise MeasurementError(f"{csv_path}: row {skip + 1}: {len(first.strip().split(','))} fields but "
-                               f"{len(names)} column names{hint}")
-    return names, skip
+    names = [h.strip().strip('"').strip("'") for h in line.strip().split(delimiter)]
+    fields = len(first.strip().split(delimiter))
+    if first.strip() and fields != len(names):
+        hint = " (decimal commas? use '.' as the decimal mark)" if fields > len(names) else ""
+        raise MeasurementError(f"{csv_path}: row {skip + 1}: {fields} fields but {len(names)} column names{hint}")
+    return names, skip, delimiter
 
 
-def _load_columns(csv_path, names, skip, wanted: list[str]) -> dict[str, np.ndarray]:
+def _load_columns(csv_path, names, skip, delimiter, wanted: list[str]) -> dict[str, np.ndarray]:
     idx = [names.index(w) for w in wanted]
     try:
-        data = np.loadtxt(csv_path, delimiter=",", skiprows=skip, usecols=idx, ndmin=2, comments="#",
+        data = np.loadtxt(csv_path, delimiter=delimiter, skiprows=skip, usecols=idx, ndmin=2, comments="#",
                           encoding="utf-8-sig")
     except ValueError as exc:
         raise MeasurementError(f"{csv_path}: not numeric in a used column ({', '.join(wanted)}): {exc}; "
@@ -159,13 +162,13 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
         fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join(TIME_UNITS), MeasurementError)
     inputs = _channels(side, meta["inputs"], "inputs")
     outputs = _channels(side, meta["outputs"], "outputs")
-    names, skip = _header(csv_path)
+    names, skip, delimiter = _header(csv_path)
     for name in list(inputs) + list(outputs):
         if name not in names:
             raise MeasurementError(f"{csv_path}: column '{name}' named in {side.name} is missing; "
                                    f"columns: {', '.join(names)}")
     time_col = meta["time_column"] if meta["time_column"] in names else None
-    cols = _load_columns(csv_path, names, skip, ([time_col] if time_col else []) + list({**inputs, **outputs}))
+    cols = _load_columns(csv_path, names, skip, delimiter, ([time_col] if time_col else []) + list({**inputs, **outputs}))
     n = len(next(iter(cols.values())))
     if time_col:
         t_file = cols.pop(time_col) * TIME_UNITS[meta["time_unit"]]

@@ -95,8 +95,10 @@ class FitConfig:
         return hashlib.sha256(json.dumps(spec).encode()).hexdigest()[:16]
 
 
-def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
-    """Read and validate a fit study. fmu_parameters(model) -> set of settable names (to reject unknown ones)."""
+def load_fit(path: str | pathlib.Path, fmu_parameters=None, nominal=None) -> FitConfig:
+    """Read and validate a fit study. fmu_parameters(model) -> set of settable names (to reject unknown ones).
+    nominal: a described system (pyfit.io.nominal.NominalModel): its parameters are fixed in every FMU run,
+    under the study's [experiment] table and except the fitted variables."""
     path = pathlib.Path(path)
     doc = read_toml(path, ConfigError)
     check_sections(doc, path, ("fit", "target", "experiment", "objective", "variables", "nno", "polish", "ga",
@@ -148,7 +150,8 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
         synthetic = sy
     elif not target_file.is_file():
         fail(path, "target.file", f"measurement {target_file} not found (and no [target.synthetic] to make it)")
-    fixed = check_numbers(doc.get("experiment", {}), path, "experiment")
+    fixed = {**{k: v for k, v in (nominal.parameters() if nominal else {}).items() if k not in doc["variables"]},
+             **check_numbers(doc.get("experiment", {}), path, "experiment")}
     ob = check_table(doc["objective"], path, "objective", {
         "kind": (str, False, "psd_band"), "channels": (list, True, None), "segment_s": (float, False, 8.0),
         "warmup_s": (float, False, 0.0), "penalty": (float, False, 10.0)})
@@ -175,7 +178,7 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None) -> FitConfig:
         known = fmu_parameters(fit["model"])
         for name in [v.name for v in variables] + list(fixed):
             if name not in known:
-                fail(path, "variables" if name in doc["variables"] else "experiment",
+                fail(path, "variables" if name in doc["variables"] else "experiment (or --nominal)",
                       f"model {fit['model']} has no parameter '{name}'", ", ".join(sorted(known)))
     nn = check_table(doc.get("nno", {}), path, "nno", {
         "init_sim": (int, False, 20), "hidden_sizes": (list, False, [15]), "p_size": (int, False, 20),

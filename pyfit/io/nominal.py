@@ -44,6 +44,10 @@ class NominalModel:
     free: dict[str, FreeParameter] = field(default_factory=dict)
     path: pathlib.Path | None = None
 
+    def parameters(self) -> dict[str, float]:
+        """FMU parameter values of the described system: the known ones and the starts of the uncertain ones."""
+        return {**self.fixed, **{n: p.start for n, p in self.free.items() if p.start is not None}}
+
     def check_names(self, settable: set[str]) -> None:
         """Every named parameter must be one the FMU accepts."""
         for section, names in (("fixed", self.fixed), ("free", self.free)):

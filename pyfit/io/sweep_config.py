@@ -53,8 +53,11 @@ class SweepConfig:
     title: str = ""
 
 
-def load_sweep(path: str | pathlib.Path, fmu_variables=None) -> SweepConfig:
+def load_sweep(path: str | pathlib.Path, fmu_variables=None, nominal=None) -> SweepConfig:
     """Read and validate a sweep study file.
+
+    nominal: a described system (pyfit.io.nominal.NominalModel): its parameters apply to every run, under
+    the study's own [parameters] and parameter sets.
 
     fmu_variables(model) -> an object with .parameters (names that can be set), .variables (all names)
     and .outputs (the FMU's outputs, the default); used to reject unknown names.
@@ -87,7 +90,8 @@ def load_sweep(path: str | pathlib.Path, fmu_variables=None) -> SweepConfig:
     if ex["kind"] in ("log_sweep", "cv_linear_sweep", "cv_log_sweep") and ex["f_start"] <= 0:
         fail(path, "excitation.f_start", "log and constant-velocity sweeps need f_start > 0")
     excitation = ExcitationConfig(**ex)
-    parameters = check_numbers(doc.get("parameters", {}), path, "parameters")
+    parameters = {**(nominal.parameters() if nominal else {}),
+                  **check_numbers(doc.get("parameters", {}), path, "parameters")}
     sets = []
     for i, s in enumerate(doc.get("parameter_sets", [{"name": "default"}])):
         if "name" not in s or not isinstance(s["name"], str):

@@ -28,13 +28,15 @@ RESULTS = {
     "docs/results/diagnose_benchmark.md": ("results/diagnose_benchmark/report.md",
                                            "python scripts/diagnose.py --benchmark --config "
                                            "configs/diagnose_benchmark.toml --out results/diagnose_benchmark"),
+    "docs/results/lab_example.md": ("results/lab_report/report.md",
+                                    "python scripts/diagnose.py --make-datasets results/lab --excitation sweep "
+                                    "--record a --seeds 0 && python scripts/diagnose.py --model sdof --data "
+                                    "results/lab/sdof_hysteresis --out results/lab_report"),
     "docs/results/boucwen_benchmark.md": ("results/boucwen_benchmark/summary.md",
                                           "python scripts/fit.py configs/boucwen_benchmark.toml --repeats 2 "
                                           "--out results/boucwen_benchmark"),
-    "docs/results/bench_sdof_eval.md": ("results/bench/sdof_eval.md", "python bench/sdof_eval.py"),
     "docs/results/bench_batch_speedup.md": ("results/bench/batch_speedup.md", "python bench/batch_speedup.py"),
     "docs/results/bench_fmu_soak.md": ("results/bench/fmu_soak.md", "python bench/fmu_soak.py"),
-    "docs/results/bench_diagnose_time.md": ("results/bench/diagnose_time.md", "python bench/diagnose_time.py"),
 }
 
 

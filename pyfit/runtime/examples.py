@@ -6,15 +6,17 @@ import pathlib
 import numpy as np
 from fmpy import read_model_description
 
-from pyfit.build import EXAMPLES, build_fmu
+from pyfit.build import EXAMPLES, LIBRARY, build_fmu
 from pyfit.runtime.fmu import FmuRunner
 
 
 def ensure_fmu(name: str, fmu_dir: pathlib.Path) -> pathlib.Path:
-    """Path of the example's FMU, building it from the .mo sources if it is missing."""
-    path = fmu_dir / f"{name}.fmu"
-    if not path.exists():
-        build_fmu(EXAMPLES[name], fmu_dir, name)
+    """Path of the example's FMU, built from the .mo sources if it is missing or older than any of them (the
+    .mo files are the single source of truth)."""
+    path = pathlib.Path(fmu_dir) / f"{name}.fmu"
+    newest_source = max(p.stat().st_mtime for p in LIBRARY.rglob("*.mo"))
+    if not path.exists() or path.stat().st_mtime < newest_source:
+        build_fmu(EXAMPLES[name], pathlib.Path(fmu_dir), name)
     return path
 
 
