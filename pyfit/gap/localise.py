@@ -41,7 +41,7 @@ def _noise_variance(rec: Record, y: np.ndarray) -> tuple[float, str]:
     - 'pre-excitation': the record starts with at least 0.2 s before the input rises above 1 % of its peak;
     - 'unexcited lines': a single period of a periodic record: the DFT lines the input does not excite (an
       upper bound: distortion lands there too);
-    - 'quiet band': white noise level from the output PSD between 3x the highest excited frequency and
+    - 'quiet band': white noise level from the output PSD between 2x the highest excited frequency and
       0.4 fs (median over the bins, so that harmonic lines there do not count), when that band exists;
     - 'coherence': otherwise the output power not coherent with the input over the excited band (an upper
       bound: nonlinear distortion is not coherent either)."""
@@ -63,7 +63,7 @@ def _noise_variance(rec: Record, y: np.ndarray) -> tuple[float, str]:
     on = np.flatnonzero(puu > 1e-3 * puu[1:].max())
     f_hi = f[on[-1]] if on.size else 0.0
     _, pyy = scipy.signal.welch(y, rec.fs, nperseg=int(seg * rec.fs))
-    quiet = (f >= 3 * f_hi) & (f <= 0.4 * rec.fs)
+    quiet = (f >= 2 * f_hi) & (f <= 0.4 * rec.fs)
     if quiet.sum() >= 8:
         return float(np.median(pyy[quiet]) * rec.fs / 2), "quiet band"
     _, coh = scipy.signal.coherence(u, y, rec.fs, nperseg=int(seg * rec.fs))

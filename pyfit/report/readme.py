@@ -5,7 +5,8 @@ content of one committed result file:
     (the file's content)
     <!-- end generated -->
 
-`collect` copies each result a command has written under results/ to its committed place (RESULTS);
+`collect` copies each result a command has written under results/ to its committed place (RESULTS), with
+the figures it links to;
 `render` rewrites every block from its file; `stale` names the blocks that differ from their files.
 """
 from __future__ import annotations
@@ -72,7 +73,12 @@ def collect(root: pathlib.Path) -> list[str]:
         if src.is_file():
             dst = root / committed
             dst.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(src, dst)
+            text = src.read_text(encoding="utf-8")
+            for name in set(re.findall(r"\]\(([\w.-]+\.png)\)", text)):  # figures beside the result file
+                if (src.parent / name).is_file():
+                    shutil.copyfile(src.parent / name, dst.parent / f"{dst.stem}_{name}")
+                    text = text.replace(f"]({name})", f"]({dst.parent.relative_to(root).as_posix()}/{dst.stem}_{name})")
+            dst.write_text(text, encoding="utf-8")
             copied.append(committed)
     return copied
 
