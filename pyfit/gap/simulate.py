@@ -56,7 +56,8 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> R
     ones not recorded are derived from the recorded one (pyfit.analysis.kinematics, band-limited to the
     excited band).
     A non-periodic record that does not start at rest (a segment cut from a long record) is simulated from
-    rest and its first transient_s seconds are not compared (the start-up transient of the simulation)."""
+    rest and its first transient_s seconds (at most a quarter of the record) are not compared (the start-up
+    transient of the simulation)."""
     exc = m.excitation or {}
     spp = int(exc.get("samples_per_period", 0)) if exc.get("kind") == "multisine" else 0
     n = len(m.t)
@@ -75,10 +76,8 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> R
         derived = tuple(var for kind, var in zip("xva", motion) if var not in inputs)
         inputs = {**inputs, **{var: full[kind] for kind, var in zip("xva", motion)}}
     weights = {ch.model_variable: ch.weight for ch in m.outputs.values()}
-    first = 0 if spp or starts_at_rest(m) else int(round(transient_s * m.sample_rate_hz))
-    if first >= n // 2:
-        raise ValueError(f"{m.path}: the record does not start at rest and is too short to drop a "
-                         f"{transient_s:g} s transient (it has {n / m.sample_rate_hz:g} s)")
+    # at most a quarter of a short record is given up to the start-up transient
+    first = 0 if spp or starts_at_rest(m) else min(int(round(transient_s * m.sample_rate_hz)), n // 4)
     outputs = {k: v[first:] for k, v in m.by_variable("outputs").items()}
     return Record(m.path.stem, m.level, float(m.level_value if m.level_value is not None else 0.0),
                   m.sample_rate_hz, inputs, outputs, spp, weights, derived, first)
