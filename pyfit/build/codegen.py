@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import re
 import pathlib
 import uuid
 import xml.etree.ElementTree as ET
@@ -74,20 +75,45 @@ def _derivative_unit(unit: str) -> str:
     return {"m": "m/s", "m/s": "m/s2", "rad": "rad/s", "rad/s": "rad/s2", "N": "N/s"}.get(unit, "")
 
 
+SAMPLED_SWITCH = "exc_type"  # the built-in excitation selector; 0 = inputs only (every run driven by data)
+FAST_POW = """
+/* pow with the exponents the models use most, exactly (x^1 = x, x^2 = x*x are correctly rounded) */
+static inline double pyfit_pow(double x, double y) { return y == 1.0 ? x : y == 2.0 ? x * x : pow(x, y); }
+"""
+
+
 def casadi_functions(model: ExplicitModel, ident: str) -> list[ca.Function]:
-    """The four functions the wrapper calls: ode, vars, calc, jac (dense, column-major)."""
+    """The functions the wrapper calls, for each variant: ode, vars, jac (dense, column-major) and hoist,
+    plus calc.
+
+    Variant "" is the general model; variant "_s" (only for models with the parameter exc_type) has
+    exc_type = 0 substituted, so a run driven by sampled inputs does not evaluate the built-in excitation's
+    expressions. In each variant every subexpression that depends on parameters only is moved into the
+    variant's `hoist` function (evaluated when a parameter changes, not at every right-hand side call) and
+    enters ode/vars/jac as their fifth argument h.
+    """
     args = [model.x, model.u, model.p, model.t]
-    names = ["x", "u", "p", "t"]
-    ode = ca.Function(f"{ident}_ode", args, [model.xdot], names, ["xdot"])
+    names = ["x", "u", "p", "t", "h"]
     allv = ca.vertcat(*model.variable_expr) if model.variable_expr else ca.SX(0, 1)
-    var = ca.Function(f"{ident}_vars", args, [allv], names, ["v"])
     calc = ca.Function(f"{ident}_calc", [model.p],
                        [ca.vertcat(*model.calculated_expr) if model.calculated_expr else ca.SX(0, 1)],
                        ["p"], ["c"])
-    out = ca.vertcat(model.xdot, allv)
-    jac = ca.Function(f"{ident}_jac", args, [ca.densify(ca.jacobian(out, ca.vertcat(model.x, model.u)))],
-                      names, ["J"])
-    return [ode, var, calc, jac]
+    functions = [calc]
+    pnames = [v.name for v in model.parameters]
+    variants = {"": None}
+    if SAMPLED_SWITCH in pnames:
+        variants["_s"] = model.p[pnames.index(SAMPLED_SWITCH)]
+    for suffix, switch in variants.items():
+        xdot, var = (model.xdot, allv) if switch is None else (ca.substitute(e, switch, 0) for e in (model.xdot, allv))
+        jac = ca.densify(ca.jacobian(ca.vertcat(xdot, var), ca.vertcat(model.x, model.u)))
+        (xdot, var, jac), symbols, parametric = ca.extract_parametric([xdot, var, jac], model.p)
+        h = ca.vertcat(*symbols) if symbols else ca.SX(0, 1)
+        functions += [ca.Function(f"{ident}_hoist{suffix}", [model.p],
+                                  [ca.vertcat(*parametric) if parametric else ca.SX(0, 1)], ["p"], ["h"]),
+                      ca.Function(f"{ident}_ode{suffix}", args + [h], [xdot], names, ["xdot"]),
+                      ca.Function(f"{ident}_vars{suffix}", args + [h], [var], names, ["v"]),
+                      ca.Function(f"{ident}_jac{suffix}", args + [h], [jac], names, ["J"])]
+    return functions
 
 
 def write_sources(model: ExplicitModel, ident: str, guid: str, variables: list[FmuVariable],
@@ -95,9 +121,14 @@ def write_sources(model: ExplicitModel, ident: str, guid: str, variables: list[F
     """Write model_functions.c/.h and model_data.h into `folder`; return the C file names."""
     folder.mkdir(parents=True, exist_ok=True)
     gen = ca.CodeGenerator("model_functions.c", {"with_header": True})
-    for f in casadi_functions(model, ident):
+    functions = casadi_functions(model, ident)
+    for f in functions:
         gen.add(f)
     gen.generate(str(folder) + "/")
+    code = (folder / "model_functions.c").read_text()
+    head = code.index("#include <math.h>") + len("#include <math.h>")
+    (folder / "model_functions.c").write_text(code[:head] + FAST_POW + re.sub(r"\bpow\(", "pyfit_pow(", code[head:]))
+    n_hoist = max(f.nnz_out(0) for f in functions if "_hoist" in f.name())
     types = {"Real": 0, "Integer": 1}
     starts = [v.start if v.start is not None else 0.0 for v in variables]
     lines = [
@@ -112,9 +143,13 @@ def write_sources(model: ExplicitModel, ident: str, guid: str, variables: list[F
         f"#define N_VARS {len(model.variables)}",
         f"#define VR_CS_STEP {len(model.parameters)}",
     ]
-    for key in ("ode", "vars", "calc", "jac"):
-        lines.append(f"#define FUN_{key.upper()} {ident}_{key}")
-        lines.append(f"#define FUN_{key.upper()}_work {ident}_{key}_work")
+    lines.append(f"#define N_HOIST {n_hoist}")
+    sampled = SAMPLED_SWITCH in [v.name for v in model.parameters]
+    lines.append(f"#define VR_SAMPLED_SWITCH {[v.name for v in model.parameters].index(SAMPLED_SWITCH) if sampled else -1}")
+    for f in functions:
+        key = f.name()[len(ident) + 1:].upper()
+        lines.append(f"#define FUN_{key} {f.name()}")
+        lines.append(f"#define FUN_{key}_work {f.name()}_work")
     lines.append("static const double START_VALUES[] = {" + ", ".join(repr(float(s)) for s in starts) + "};")
     lines.append("static const int VAR_TYPE[] = {" + ", ".join(str(types[v.type]) for v in variables) + "};")
     lines.append("static const int VAR_SETTABLE[] = {" + ", ".join(str(v.settable) for v in variables) + "};")

@@ -9,6 +9,11 @@
  * fmi2SetupExperiment, default 1e-8) or, if the parameter cs_step > 0, with classic Runge-Kutta 4 at a
  * fixed sub-step <= cs_step. Inputs are interpolated within a communication step from the derivatives
  * set with fmi2SetRealInputDerivatives (orders 1 and 2).
+ *
+ * Each model function comes in up to two variants (model_data.h): the general one and, for models with
+ * the parameter exc_type, one with exc_type = 0 (no built-in excitation: every run driven by sampled
+ * inputs). The variant is chosen, and the parameter-only subexpressions ("hoist") evaluated, whenever a
+ * parameter has changed, not at every right-hand side call.
  */
 #include <float.h>
 #include <math.h>
@@ -33,6 +38,8 @@
 
 enum { ST_INSTANTIATED, ST_INIT, ST_STEP, ST_EVENT, ST_CONT, ST_TERMINATED, ST_ERROR };
 
+typedef int (*ModelFunction)(const casadi_real **, casadi_real **, casadi_int *, casadi_real *, int);
+
 typedef struct {
   fmi2Type type;
   int state;
@@ -45,6 +52,9 @@ typedef struct {
   double time;
   double rtol;
   int dirty;
+  int params_dirty; /* a parameter changed: calculated parameters, variant and hoisted values are stale */
+  ModelFunction ode, vars, jac;
+  double hoist[ARRSZ(N_HOIST)];
   /* CasADi work memory */
   const double **arg;
   double **res;
@@ -56,7 +66,7 @@ typedef struct {
   double xscale[ARRSZ(N_STATES)];
   double utmp[ARRSZ(N_INPUTS)];
   double h_last;
-  double jac[ARRSZ(N_OUT * N_XU)];
+  double jacobian[ARRSZ(N_OUT * N_XU)];
 } Instance;
 
 static void logmsg(Instance *c, fmi2Status st, const char *fmt, ...) {
@@ -78,21 +88,36 @@ static void logmsg(Instance *c, fmi2Status st, const char *fmt, ...) {
 }
 
 /* ---- calls into the generated functions ----------------------------------------------------- */
-static int call_ode(Instance *c, const double *x, const double *u, double t, double *xdot) {
-  c->arg[0] = x; c->arg[1] = u; c->arg[2] = c->v; c->arg[3] = &t;
-  c->res[0] = xdot;
-  return FUN_ODE(c->arg, c->res, c->iw, c->w, 0);
+static int call_model(Instance *c, ModelFunction f, const double *x, const double *u, const double *t, double *out) {
+  c->arg[0] = x; c->arg[1] = u; c->arg[2] = c->v; c->arg[3] = t; c->arg[4] = c->hoist;
+  c->res[0] = out;
+  return f(c->arg, c->res, c->iw, c->w, 0);
 }
 
+static int call_ode(Instance *c, const double *x, const double *u, double t, double *xdot) {
+  return call_model(c, c->ode, x, u, &t, xdot);
+}
+
+/* calculated parameters, the model variant and its parameter-only subexpressions, if a parameter changed */
 static int update_calculated(Instance *c) {
+  ModelFunction hoist = FUN_HOIST;
+  if (!c->params_dirty) return 0;
 #if N_CALC > 0
   c->arg[0] = c->v;
   c->res[0] = c->v + OFS_CALC;
-  return FUN_CALC(c->arg, c->res, c->iw, c->w, 0);
-#else
-  (void)c;
-  return 0;
+  if (FUN_CALC(c->arg, c->res, c->iw, c->w, 0)) return 1;
 #endif
+  c->ode = FUN_ODE; c->vars = FUN_VARS; c->jac = FUN_JAC;
+#if VR_SAMPLED_SWITCH >= 0
+  if (c->v[VR_SAMPLED_SWITCH] == 0.0) {
+    c->ode = FUN_ODE_S; c->vars = FUN_VARS_S; c->jac = FUN_JAC_S; hoist = FUN_HOIST_S;
+  }
+#endif
+  c->arg[0] = c->v;
+  c->res[0] = c->hoist;
+  if (hoist(c->arg, c->res, c->iw, c->w, 0)) return 1;
+  c->params_dirty = 0;
+  return 0;
 }
 
 static int finite_all(const double *a, int n) {
@@ -107,9 +132,7 @@ static fmi2Status update_all(Instance *c) {
   if (update_calculated(c)) return fmi2Error;
   if (call_ode(c, c->v + OFS_STATE, c->v + OFS_INPUT, c->time, c->v + OFS_DER)) return fmi2Error;
 #if N_VARS > 0
-  c->arg[0] = c->v + OFS_STATE; c->arg[1] = c->v + OFS_INPUT; c->arg[2] = c->v; c->arg[3] = &t;
-  c->res[0] = c->v + OFS_VAR;
-  if (FUN_VARS(c->arg, c->res, c->iw, c->w, 0)) return fmi2Error;
+  if (call_model(c, c->vars, c->v + OFS_STATE, c->v + OFS_INPUT, &t, c->v + OFS_VAR)) return fmi2Error;
 #endif
   c->dirty = 0;
   if (!finite_all(c->v + OFS_DER, N_STATES)) {
@@ -136,6 +159,7 @@ static void reset_values(Instance *c) {
   c->time = 0.0;
   c->rtol = 1e-8;
   c->dirty = 1;
+  c->params_dirty = 1;
   c->h_last = 0.0;
   c->state = ST_INSTANTIATED;
 }
@@ -163,6 +187,13 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, f
   WORK(FUN_VARS)
   WORK(FUN_CALC)
   WORK(FUN_JAC)
+  WORK(FUN_HOIST)
+#if VR_SAMPLED_SWITCH >= 0
+  WORK(FUN_ODE_S)
+  WORK(FUN_VARS_S)
+  WORK(FUN_JAC_S)
+  WORK(FUN_HOIST_S)
+#endif
 #undef WORK
   c->arg = (const double **)calloc(sz_arg + 1, sizeof(double *));
   c->res = (double **)calloc(sz_res + 1, sizeof(double *));
@@ -193,6 +224,7 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component comp) {
   Instance *c = (Instance *)comp;
   c->state = ST_INIT;
   c->dirty = 1;
+  c->params_dirty = 1;
   return update_calculated(c) ? fmi2Error : fmi2OK;
 }
 
@@ -253,6 +285,7 @@ static fmi2Status set_values(Instance *c, const fmi2ValueReference vr[], size_t 
       return fmi2Error;
     }
     c->v[vr[i]] = in[i];
+    if (kind == 1) c->params_dirty = 1;
   }
   c->dirty = 1;
   return fmi2OK;
@@ -349,6 +382,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component comp, fmi2FMUstate s) {
   c->time = sn->time;
   c->state = sn->state;
   c->dirty = 1;
+  c->params_dirty = 1;
   return fmi2OK;
 }
 
@@ -389,9 +423,7 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2ValueRefer
   double t = c->time;
   size_t i, j;
   if (update_calculated(c)) return fmi2Error;
-  c->arg[0] = c->v + OFS_STATE; c->arg[1] = c->v + OFS_INPUT; c->arg[2] = c->v; c->arg[3] = &t;
-  c->res[0] = c->jac;
-  if (FUN_JAC(c->arg, c->res, c->iw, c->w, 0)) return fmi2Error;
+  if (call_model(c, c->jac, c->v + OFS_STATE, c->v + OFS_INPUT, &t, c->jacobian)) return fmi2Error;
   for (i = 0; i < nU; i++) {
     long row;
     if (vUnknown[i] >= OFS_DER && vUnknown[i] < OFS_VAR) row = (long)(vUnknown[i] - OFS_DER);
@@ -404,7 +436,7 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2ValueRefer
       else if (vKnown[j] >= OFS_INPUT && vKnown[j] < OFS_STATE) col = N_STATES + (long)(vKnown[j] - OFS_INPUT);
       else { logmsg(c, fmi2Error, "value reference %u is not a known", (unsigned)vKnown[j]); return fmi2Error; }
       /* CasADi stores dense matrices column-major */
-      dvUnknown[i] += c->jac[col * N_OUT + row] * dvKnown[j];
+      dvUnknown[i] += c->jacobian[col * N_OUT + row] * dvKnown[j];
     }
   }
   return fmi2OK;

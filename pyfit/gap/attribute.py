@@ -45,7 +45,7 @@ class FitTask:
     budget: int
     upsample: int
     lead_periods: int = 1
-    scan: tuple = ()  # (parameter, factors): the start is the best of start[parameter] x each factor
+    alternatives: tuple = ()  # other starts (dicts of parameter overrides): the least squares starts from the best
 
 
 def _stacked(runner, records, params: dict, upsample: int, lead_periods: int) -> np.ndarray:
@@ -68,16 +68,12 @@ def run_fit(task: FitTask) -> Fit:
     def residuals(p):
         return _stacked(runner, task.records, p, task.upsample, task.lead_periods)
 
-    x0 = (np.array([task.start[n] for n in names]) - lo) / (hi - lo)
-    scanned = 0
-    if task.scan:  # find the basin: the start with one parameter scaled, best time-domain residual
-        name, factors = task.scan
-        j = names.index(name)
-        candidates = []
-        for f in factors:
-            x = x0.copy()
-            x[j] = (task.start[name] * f - lo[j]) / (hi[j] - lo[j])
-            candidates.append(np.clip(x, 0.0, 1.0))
+    def scaled(start):
+        return np.clip((np.array([start[n] for n in names]) - lo) / (hi - lo), 0.0, 1.0)
+
+    x0, scanned = scaled(task.start), 0
+    if task.alternatives:  # find the basin: the start with the best time-domain residual
+        candidates = [x0] + [scaled({**task.start, **alt}) for alt in task.alternatives]
         errors = [float(np.sum(residuals(params(x)) ** 2)) for x in candidates]
         x0, scanned = candidates[int(np.argmin(errors))], len(candidates)
     # least squares from there; it returns the best point it evaluated, so never worse than its start
@@ -90,6 +86,7 @@ def run_fit(task: FitTask) -> Fit:
 
 
 STIFFNESS_SCAN = (0.25, 0.5, 1.0, 2.0, 4.0)  # factors on the nominal stiffness tried before the least squares
+STRENGTH_FACTORS = (0.25, 0.5, 1.0)  # factors on the screening's Gauss-Newton effect strength tried likewise
 
 
 def nominal_task(system: System, fmu: str, records: list, budget: int, upsample: int) -> FitTask:
@@ -97,13 +94,15 @@ def nominal_task(system: System, fmu: str, records: list, budget: int, upsample:
     described values), the best of the stiffness scaled by STIFFNESS_SCAN, then least squares."""
     start = system.start(records)
     bounds = system.bounds(start)
-    scan = (system.stiffness, STIFFNESS_SCAN) if system.stiffness in start else ()
+    scan = system.stiffness in start
     if scan:  # let the bounds hold the whole scan
         lo, hi = bounds[system.stiffness]
         bounds[system.stiffness] = (min(lo, start[system.stiffness] * min(STIFFNESS_SCAN)),
                                     max(hi, start[system.stiffness] * max(STIFFNESS_SCAN)))
+    alternatives = tuple({system.stiffness: start[system.stiffness] * f} for f in STIFFNESS_SCAN if f != 1.0) \
+        if scan else ()
     return FitTask(fmu, tuple(records), dict(system.nominal_fixed), {n: start[n] for n in system.linear},
-                   bounds, "nominal", 0, budget, upsample, system.lead_periods, scan)
+                   bounds, "nominal", 0, budget, upsample, system.lead_periods, alternatives)
 
 
 def effect_start(system: System, effect: Effect, scale: Scale, nominal: dict) -> tuple[dict, dict, dict]:
@@ -119,19 +118,24 @@ def effect_start(system: System, effect: Effect, scale: Scale, nominal: dict) ->
 
 
 def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal: Fit, scale: Scale,
-                budget: int, upsample: int) -> FitTask:
-    """The refit of the nominal model with `effect` added."""
+                budget: int, upsample: int, strength: dict | None = None) -> FitTask:
+    """The refit of the nominal model with `effect` added, from the best of the effect's default start and
+    the screening's Gauss-Newton `strength` (parameter -> value) scaled by STRENGTH_FACTORS (the step
+    linearises an effect that is not linear in its strength: it can overshoot)."""
     start, bounds, fixed = effect_start(system, effect, scale, nominal.params)
+    alternatives = tuple({n: v * f for n, v in strength.items()} for f in STRENGTH_FACTORS) if strength else ()
     return FitTask(fmu, tuple(records), {**system.nominal_fixed, **fixed}, start, bounds, effect.name,
-                   len(effect.params), budget, upsample, system.lead_periods)
+                   len(effect.params), budget, upsample, system.lead_periods, alternatives)
 
 
 def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int, effects: list,
-           probe: float = 0.05) -> dict[str, float]:
+           probe: float = 0.05) -> tuple[dict[str, float], dict[str, dict]]:
     """For each of `effects`: the fraction of the nominal residual (after re-adjusting the linear
-    parameters) that one Gauss-Newton step along the effect's sensitivity direction removes: 1 - |r - P_[J_lin, d] r|^2 / |r - P_J_lin r|^2. The direction
-    is the output change from the nominal to the effect at a small probe strength (probe x its range; a
-    hysteretic element at its start, where it is more than a stiffness)."""
+    parameters) that one Gauss-Newton step along the effect's sensitivity direction removes,
+    1 - |r - P_[J_lin, d] r|^2 / |r - P_J_lin r|^2, and the effect strength that step reaches (the refit's
+    start: parameter -> value; not for a hysteretic element, whose start is more than a strength). The
+    direction is the output change from the nominal to the effect at a small probe strength (probe x its
+    range; a hysteretic element at its start, where it is more than a stiffness)."""
     runner = FmuRunner(fmu)
     base = dict(nominal.params)
 
@@ -147,10 +151,10 @@ def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, 
 
     def unexplained(A):
         coef = np.linalg.lstsq(A, r0, rcond=None)[0]
-        return float(np.sum((r0 - A @ coef) ** 2))
+        return float(np.sum((r0 - A @ coef) ** 2)), coef
 
-    lin = unexplained(J)
-    out = {}
+    lin = unexplained(J)[0]
+    out, strengths = {}, {}
     for name in effects:
         effect = system.effects[name]
         start, _, fixed = effect_start(system, effect, scale, base)
@@ -160,6 +164,13 @@ def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, 
             # a hysteretic element at its start (more than a stiffness there); any other a small step from it
             p[prm.name] = st if effect.shift_stiffness > 0 else st + probe * (hi - st)
         d = stacked(p) - r0
-        out[name] = 1.0 - unexplained(np.column_stack([J, d])) / lin if lin > 0 else 0.0
+        rest, coef = unexplained(np.column_stack([J, d]))
+        out[name] = 1.0 - rest / lin if lin > 0 else 0.0
+        if effect.shift_stiffness == 0:  # the residual is data - model: the step is -coef along d
+            strengths[name] = {}
+            for prm in effect.params:
+                lo, st, hi = prm.range(scale)
+                step = probe * (hi - st)
+                strengths[name][prm.name] = float(np.clip(st - coef[-1] * step, lo, hi))
     runner.close()
-    return out
+    return out, strengths

@@ -203,18 +203,19 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     if gap["significant"] and nominal.calibration_nrmse <= cfg.nominal_max_nrmse:
         screening_path = out / "fits" / "screening.json"
         stored = json.loads(screening_path.read_text()) if screening_path.is_file() else {}
-        if stored.get("key") == key:
-            screening = stored["fractions"]
+        if stored.get("key") == key and "strengths" in stored:
+            screening, strengths = stored["fractions"], stored["strengths"]
         else:
-            screening = screen(system, fmu, cal, nominal, scale, cfg.upsample, effects)
-            screening_path.write_text(json.dumps({"key": key, "fractions": screening}, indent=1))
+            screening, strengths = screen(system, fmu, cal, nominal, scale, cfg.upsample, effects)
+            screening_path.write_text(json.dumps({"key": key, "fractions": screening, "strengths": strengths},
+                                                 indent=1))
         jobs = []
         for name in effects:
             path = out / "fits" / f"{name}.json"
             fits[name] = _stored(path, key)
             if fits[name] is None:
                 jobs.append((effect_task(system, system.effects[name], fmu, cal, nominal, scale, cfg.refit_budget,
-                                         cfg.upsample), str(path), key))
+                                         cfg.upsample, strengths.get(name)), str(path), key))
         for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="refits"):
             fits[fit.effect] = fit
         for name, f in fits.items():  # an effect is judged on the held-out files only

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from fmpy import calloc, extract, free, read_model_description
 from fmpy.fmi1 import FMICallException
+from pyfit.runtime.native import cs_loop
 from fmpy.fmi2 import (FMU2Model, FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
 
@@ -223,22 +224,48 @@ class FmuRunner:
             in_buf = (ctypes.c_double * k)()
             der_buf = (ctypes.c_double * k)()
             order = (ctypes.c_int * k)(*([1] * k))
-        get_real, do_step = fmu.fmi2GetReal, fmu.fmi2DoStep
-        set_real, set_der = fmu.fmi2SetReal, fmu.fmi2SetRealInputDerivatives
-        comp = fmu.component
-        for i, t in enumerate(time):
-            if k:
-                in_buf[:] = u_at[:, i]
-                set_real(comp, in_vr, k, in_buf)
-            get_real(comp, out_vr, len(outputs), out_buf)
-            result[i] = out_buf[:]
-            if i + 1 < len(time):
-                if k and not hold_inputs:
-                    der_buf[:] = slope[:, i]
-                    set_der(comp, in_vr, k, order, der_buf)
-                do_step(comp, t, time[i + 1] - t, 1)
+        loop = cs_loop()
+        if loop is not None:
+            self._run_cs_compiled(loop, fmu, time, out_vr, result, in_vr if k else None,
+                                  u_at if k else None, None if (hold_inputs or not k) else slope)
+        else:
+            get_real, do_step = fmu.fmi2GetReal, fmu.fmi2DoStep
+            set_real, set_der = fmu.fmi2SetReal, fmu.fmi2SetRealInputDerivatives
+            comp = fmu.component
+            for i, t in enumerate(time):
+                if k:
+                    in_buf[:] = u_at[:, i]
+                    set_real(comp, in_vr, k, in_buf)
+                get_real(comp, out_vr, len(outputs), out_buf)
+                result[i] = out_buf[:]
+                if i + 1 < len(time):
+                    if k and not hold_inputs:
+                        der_buf[:] = slope[:, i]
+                        set_der(comp, in_vr, k, order, der_buf)
+                    do_step(comp, t, time[i + 1] - t, 1)
         fmu.terminate()
         return {o: result[:, j].copy() for j, o in enumerate(outputs)}
+
+    @staticmethod
+    def _run_cs_compiled(loop, fmu, time, out_vr, result, in_vr, u_at, slope):
+        """The communication loop of _run_cs in C (pyfit/runtime/cs_driver.c), through the FMU's own functions."""
+        def fn(name):
+            return ctypes.cast(getattr(fmu.dll, name), ctypes.c_void_p)
+
+        def ptr(a):
+            return None if a is None else a.ctypes.data_as(ctypes.c_void_p)
+
+        time = np.ascontiguousarray(time, float)
+        u_rows = None if u_at is None else np.ascontiguousarray(u_at.T)
+        s_rows = None if slope is None else np.ascontiguousarray(slope.T)
+        status, call = ctypes.c_int(0), ctypes.c_int(0)
+        failed = loop(fmu.component, fn("fmi2SetReal"), fn("fmi2GetReal"), fn("fmi2SetRealInputDerivatives"),
+                      fn("fmi2DoStep"), len(time), ptr(time), 0 if in_vr is None else len(in_vr),
+                      in_vr, ptr(u_rows), ptr(s_rows), len(out_vr), out_vr, ptr(result),
+                      ctypes.byref(status), ctypes.byref(call))
+        if failed >= 0:
+            what = {1: "fmi2SetReal", 2: "fmi2GetReal", 3: "fmi2SetRealInputDerivatives", 4: "fmi2DoStep"}[call.value]
+            raise RuntimeError(f"{what} returned status {status.value} at t = {time[failed]:g} s")
 
     def _run_me(self, fmu, time, outputs, params, inputs, input_time, tolerance):
         from fmpy import simulate_fmu

@@ -1,0 +1,47 @@
+/* Co-simulation master loop of FmuRunner, compiled once per machine (pyfit/runtime/native.py).
+ *
+ * It calls the FMU's own FMI 2.0 functions (passed as pointers, so any FMI 2.0 co-simulation FMU
+ * works) for every communication point: set the inputs, read the outputs, send the input slopes,
+ * do the step. This is the loop FmuRunner runs in Python when no C compiler is available; here it
+ * costs nanoseconds per point instead of microseconds.
+ */
+#include <stddef.h>
+
+typedef void *fmi2Component;
+typedef unsigned int fmi2ValueReference;
+typedef int fmi2Status; /* fmi2OK = 0, fmi2Warning = 1, fmi2Discard = 2, fmi2Error = 3, fmi2Fatal = 4 */
+typedef fmi2Status (*SetRealF)(fmi2Component, const fmi2ValueReference *, size_t, const double *);
+typedef fmi2Status (*GetRealF)(fmi2Component, const fmi2ValueReference *, size_t, double *);
+typedef fmi2Status (*SetDerF)(fmi2Component, const fmi2ValueReference *, size_t, const int *, const double *);
+typedef fmi2Status (*DoStepF)(fmi2Component, double, double, int);
+
+/* Drive n_time communication points. u_at and slope are row-major (n_time x n_in): the input at each
+ * point and the slope of the linear input over the step that starts there (slope == NULL: inputs held).
+ * result is row-major (n_time x n_out). Returns -1 on success, else the index of the point whose call
+ * failed; *status gets that call's FMI status, *call which call it was (1 set, 2 get, 3 derivatives,
+ * 4 step). */
+int pyfit_cs_run(fmi2Component comp, SetRealF set_real, GetRealF get_real, SetDerF set_der, DoStepF do_step,
+                 int n_time, const double *time, int n_in, const fmi2ValueReference *in_vr, const double *u_at,
+                 const double *slope, int n_out, const fmi2ValueReference *out_vr, double *result,
+                 int *status, int *call) {
+  int i, j, order[64];
+  fmi2Status st;
+  if (n_in > 64) { *status = 3; *call = 1; return 0; }
+  for (j = 0; j < n_in; j++) order[j] = 1;
+  for (i = 0; i < n_time; i++) {
+    if (n_in > 0 && (st = set_real(comp, in_vr, (size_t)n_in, u_at + (size_t)i * n_in)) > 1) {
+      *status = st; *call = 1; return i;
+    }
+    if ((st = get_real(comp, out_vr, (size_t)n_out, result + (size_t)i * n_out)) > 1) {
+      *status = st; *call = 2; return i;
+    }
+    if (i + 1 == n_time) break;
+    if (n_in > 0 && slope && (st = set_der(comp, in_vr, (size_t)n_in, order, slope + (size_t)i * n_in)) > 1) {
+      *status = st; *call = 3; return i;
+    }
+    if ((st = do_step(comp, time[i], time[i + 1] - time[i], 1)) > 1) {
+      *status = st; *call = 4; return i;
+    }
+  }
+  return -1;
+}
