@@ -1,9 +1,10 @@
-"""Shared fixtures: the FMUs are built once per test session from the .mo sources."""
+"""Shared fixtures: the FMUs are built once per test run from the .mo sources (shared by the xdist workers)."""
+import fcntl
 import pathlib
 
 import pytest
 
-from pyfit.build import build_all
+from pyfit.build import EXAMPLES, build_fmu
 from pyfit.runtime.fmu import FmuRunner
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -11,9 +12,24 @@ SHARED_DATA = ROOT.parent / "shared" / "data" / "boucwen"
 
 
 @pytest.fixture(scope="session")
-def fmu_dir(tmp_path_factory):
-    out = tmp_path_factory.mktemp("fmus")
-    build_all(out)
+def fmu_dir(tmp_path_factory, worker_id):
+    """Every example FMU, built once per test run and shared by the xdist workers (read only): each FMU is
+    built by the first worker that claims its lock, so the workers build in parallel, then wait for the rest."""
+    root = tmp_path_factory.getbasetemp()
+    if worker_id != "master":  # xdist: the workers' temporary folders share this parent
+        root = root.parent
+    out = root / "fmus_shared"
+    out.mkdir(exist_ok=True)
+    for blocking in (False, True):
+        for name in EXAMPLES:
+            with open(out / f"{name}.lock", "w") as lock:
+                try:
+                    fcntl.flock(lock, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
+                except BlockingIOError:
+                    continue  # another worker is building it
+                if not (out / f"{name}.built").is_file():
+                    build_fmu(EXAMPLES[name], out, name)
+                    (out / f"{name}.built").touch()
     return out
 
 
@@ -69,8 +85,9 @@ def _table(rows: list[dict]) -> str:
 
 
 def pytest_sessionfinish(session, exitstatus):
-    """Write the measured figures of a run in which every test passed: with pytest-xdist each worker leaves its
-    rows in a JSON file and the controller writes the table, ordered by test file and name."""
+    """Write the measured figures of a full run (the default test paths) in which every test passed: with
+    pytest-xdist each worker leaves its rows in a JSON file and the controller writes the table, ordered by
+    test file and name."""
     import json
 
     worker = getattr(session.config, "workerinput", None)
@@ -84,7 +101,8 @@ def pytest_sessionfinish(session, exitstatus):
         for f in sorted(parts.glob("*.json")):
             rows += json.loads(f.read_text())
             f.unlink()
-    if not rows or exitstatus != 0:
+    full = session.config.args == session.config.getini("testpaths")  # not a run of chosen files
+    if not rows or exitstatus != 0 or not full:
         return
     MEASURED_TABLE.parent.mkdir(parents=True, exist_ok=True)
     MEASURED_TABLE.write_text(_table(sorted(rows, key=lambda m: (m["test"].split("::")[0], m["test"]))))

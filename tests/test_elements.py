@@ -119,17 +119,18 @@ def test_element_fmus_run_in_the_second_importer(fmu_dir, runner, tmp_path, name
                  np.max(np.abs(other[o][1:] - ours[o][:-1])) / np.max(np.abs(ours[o])), 1e-12)
 
 
-def _committed(name):
-    return np.genfromtxt(ROOT / "docs" / "fmus" / name / f"{name}_ref.csv", delimiter=",", names=True)
+def _committed(name, suffix=""):
+    return np.genfromtxt(ROOT / "docs" / "fmus" / name / f"{name}_ref{suffix}.csv", delimiter=",", names=True)
 
 
-def _bouc_wen_along(csv, rate, force):
+def _bouc_wen_along(csv, rate, force, held=False):
     """Independent integration (scipy DOP853) of dz/dt = rate(v, z) along the CSV's inputs s and v, which the
-    reference run applied linearly between their samples; the force from s and z."""
+    reference run applied linearly between their samples (held: constant over each step); the force from s
+    and z."""
     t, s_in, v_in = csv["time"], csv["s"], csv["v"]
     z = [0.0]
     for k in range(len(t) - 1):
-        v0, dv = v_in[k], (v_in[k + 1] - v_in[k]) / (t[k + 1] - t[k])
+        v0, dv = v_in[k], 0.0 if held else (v_in[k + 1] - v_in[k]) / (t[k + 1] - t[k])
         sol = scipy.integrate.solve_ivp(lambda tt, zz: [rate(v0 + dv * (tt - t[k]), zz[0])], (t[k], t[k + 1]),
                                         [z[-1]], rtol=1e-12, atol=1e-15, method="DOP853")
         z.append(sol.y[0, -1])
@@ -184,3 +185,24 @@ def test_committed_span_reference_is_reproduced_by_the_fmu_built_now(fmu_dir, tm
     worst = max(np.max(np.abs(committed[c] - fresh[c])) / max(np.max(np.abs(committed[c])), 1e-300)
                 for c in committed.dtype.names)
     measured("committed ConductorSpan reference CSV vs the FMU built now (regression)", worst, 1e-9)
+
+
+BOUC_WEN_HELD = {  # element -> (rate, force) of its law with the default parameters
+    "BoucWenElement": (lambda v, z: 5e4 * v - 1e3 * (0.8 * abs(v) * z - 1.1 * v * abs(z)), lambda s, z: -z),
+    "BoucWenNormalizedElement": (lambda v, z: (v - 0.6 * abs(v) * z - 0.4 * v * abs(z)) / 1e-3,
+                                 lambda s, z: -300.0 * (0.3 * s + 0.7 * 1e-3 * z)),
+}
+
+
+@pytest.mark.parametrize("name", list(BOUC_WEN_HELD))
+def test_held_input_reference_matches_an_independent_computation(name, measured):
+    """docs/fmus/<name>/<name>_ref_held.csv, what an importer without input derivatives reproduces, against
+    scipy integrating the law with each input held over its step; and it really differs from the
+    linear-input reference (so that the README's warning is needed)."""
+    held = _committed(name, "_held")
+    rate, force = BOUC_WEN_HELD[name]
+    ref = _bouc_wen_along(held, rate, force, held=True)
+    measured(f"committed held-input reference CSV of {name} vs scipy with held inputs: max|Δ|/max of f",
+             np.max(np.abs(held["f"] - ref)) / np.max(np.abs(ref)), 1e-7)
+    linear = _committed(name)
+    assert np.max(np.abs(held["f"] - linear["f"])) / np.max(np.abs(linear["f"])) > 1e-3

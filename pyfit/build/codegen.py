@@ -35,6 +35,7 @@ class FmuVariable:
     derivative_of: int | None = None  # vr of the state
     minimum: float = float("-inf")
     maximum: float = float("inf")
+    nominal: float | None = None
 
 
 def layout(model: ExplicitModel) -> list[FmuVariable]:
@@ -61,6 +62,7 @@ def layout(model: ExplicitModel) -> list[FmuVariable]:
     first_state = len(out)
     for v in model.states:
         add(v, "local", "continuous", "exact", v.start, 3)
+        out[-1].nominal = v.nominal
     for k, v in enumerate(model.states):
         unit = _derivative_unit(v.unit)
         add(v, "local", "continuous", "calculated", None, 0, name=f"der({v.name})", unit=unit,
@@ -150,6 +152,8 @@ def write_sources(model: ExplicitModel, ident: str, guid: str, variables: list[F
         key = f.name()[len(ident) + 1:].upper()
         lines.append(f"#define FUN_{key} {f.name()}")
         lines.append(f"#define FUN_{key}_work {f.name()}_work")
+    nominals = [v.nominal or 1.0 for v in variables if v.settable == 3]
+    lines.append("static const double STATE_NOMINALS[] = {" + ", ".join(repr(float(x)) for x in nominals or [1.0]) + "};")
     lines.append("static const double START_VALUES[] = {" + ", ".join(repr(float(s)) for s in starts) + "};")
     lines.append("static const int VAR_TYPE[] = {" + ", ".join(str(types[v.type]) for v in variables) + "};")
     lines.append("static const int VAR_SETTABLE[] = {" + ", ".join(str(v.settable) for v in variables) + "};")
@@ -215,6 +219,8 @@ def model_description(model: ExplicitModel, ident: str, guid: str, variables: li
                 tattrs["unit"] = v.unit
             if v.derivative_of is not None:
                 tattrs["derivative"] = str(v.derivative_of + 1)
+        if v.nominal:
+            tattrs["nominal"] = _fmt(v.nominal)
         for key, bound in (("min", v.minimum), ("max", v.maximum)):
             if math.isfinite(bound):
                 tattrs[key] = str(int(bound)) if v.type == "Integer" else _fmt(bound)

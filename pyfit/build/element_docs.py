@@ -47,7 +47,9 @@ def _table(md, causality: str) -> list[str]:
 
 
 def write_docs(name: str, fmu: str | pathlib.Path, out_dir: str | pathlib.Path) -> pathlib.Path:
-    """Write out_dir/<name>/README.md and <name>_ref.csv (the reference run of REFERENCE_RUNS[name])."""
+    """Write out_dir/<name>/README.md and <name>_ref.csv (the reference run of REFERENCE_RUNS[name]); for an
+    element driven by inputs also <name>_ref_held.csv, the same run with each input held over a
+    communication step (what an importer that sets no input derivatives computes)."""
     what, make_inputs, params, outputs = REFERENCE_RUNS[name]
     folder = pathlib.Path(out_dir) / name
     folder.mkdir(parents=True, exist_ok=True)
@@ -63,6 +65,22 @@ def write_docs(name: str, fmu: str | pathlib.Path, out_dir: str | pathlib.Path) 
     csv = folder / f"{name}_ref.csv"
     np.savetxt(csv, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols), comments="",
                fmt="%.12g")
+    held_note = ""
+    if inputs:
+        held = runner.simulate(STOP, STEP, outputs, params, inputs=inputs, input_time=t, tolerance=1e-10,
+                               hold_inputs=True)
+        if not held.ok:
+            raise RuntimeError(f"{name}: held-input reference run failed: {held.message}")
+        np.savetxt(folder / f"{name}_ref_held.csv",
+                   np.column_stack([t, *inputs.values(), *(held[o] for o in outputs)]), delimiter=",",
+                   header=",".join(cols), comments="", fmt="%.12g")
+        gaps = ", ".join(f"{o} {np.max(np.abs(held[o] - res[o])) / np.max(np.abs(res[o])) * 100:.1f} %" for o in outputs)
+        held_note = (f"An importer that holds each input constant over a communication step (one that sets no "
+                     f"input derivatives, e.g. fmi-sim 0.7) computes a different, coarser input: it "
+                     f"reproduces [`{name}_ref_held.csv`]({name}_ref_held.csv) (same run, inputs held), not "
+                     f"`{csv.name}`. They differ by (max |difference| / max |output|): {gaps}. To get the "
+                     "linear-input result from such an importer, sample the inputs finer (the difference "
+                     "falls with the square of the step).")
     runner.close()
     lines = [f"# {name}", "", md.description or "", "",
              f"FMI {md.fmiVersion} Model Exchange and Co-Simulation, generated from "
@@ -72,6 +90,6 @@ def write_docs(name: str, fmu: str | pathlib.Path, out_dir: str | pathlib.Path) 
     lines += ["## Variables (SI units)", ""] + _table(md, "input") + _table(md, "output") + _table(md, "parameter")
     lines += ["## Reference result", "", f"[`{csv.name}`]({csv.name}): {what}; output interval {STEP} s, "
               f"{STOP} s, tolerance 1e-10, inputs linear between samples. Regenerate with "
-              "`python scripts/element_docs.py`.", ""]
+              "`python scripts/element_docs.py`.", ""] + ([held_note, ""] if held_note else [])
     (folder / "README.md").write_text("\n".join(lines))
     return folder

@@ -14,6 +14,11 @@
  * the parameter exc_type, one with exc_type = 0 (no built-in excitation: every run driven by sampled
  * inputs). The variant is chosen, and the parameter-only subexpressions ("hoist") evaluated, whenever a
  * parameter has changed, not at every right-hand side call.
+ *
+ * Calls are checked against the FMI 2.0 state machine: a call in a state where the standard does not
+ * allow it is logged (naming the call and the state) and returns fmi2Error. A failure (non-finite
+ * derivative, failed integration) puts the instance in the error state: every later call except
+ * fmi2Reset, fmi2FreeInstance and fmi2SetDebugLogging returns fmi2Error until fmi2Reset.
  */
 #include <float.h>
 #include <math.h>
@@ -37,6 +42,13 @@
 #define ARRSZ(n) ((n) > 0 ? (n) : 1)
 
 enum { ST_INSTANTIATED, ST_INIT, ST_STEP, ST_EVENT, ST_CONT, ST_TERMINATED, ST_ERROR };
+static const char *STATE_NAME[] = {"the instantiated state", "initialization mode", "step mode", "event mode",
+                                   "continuous-time mode", "the terminated state", "the error state"};
+#define IN(s) (1 << (s))
+#define LIVE (IN(ST_INIT) | IN(ST_STEP) | IN(ST_EVENT) | IN(ST_CONT) | IN(ST_TERMINATED))
+#define ANY_BUT_ERROR (IN(ST_INSTANTIATED) | LIVE)
+#define CS_ONLY 1
+#define ME_ONLY 2
 
 typedef int (*ModelFunction)(const casadi_real **, casadi_real **, casadi_int *, casadi_real *, int);
 
@@ -87,6 +99,26 @@ static void logmsg(Instance *c, fmi2Status st, const char *fmt, ...) {
   c->cb->logger(c->cb->componentEnvironment, c->name, st, st == fmi2OK ? "logAll" : "logStatusError", out);
 }
 
+/* 1 if `fn` may be called now (states in `mask`, interface restriction `only`); else logs why, returns 0 */
+static int allowed(Instance *c, int mask, int only, const char *fn) {
+  if (!c) return 0;
+  if (c->state == ST_ERROR && !(mask & IN(ST_ERROR))) {
+    logmsg(c, fmi2Error, "%s: the instance failed earlier and is in the error state; call fmi2Reset", fn);
+    return 0;
+  }
+  if ((only == CS_ONLY && c->type != fmi2CoSimulation) || (only == ME_ONLY && c->type != fmi2ModelExchange)) {
+    logmsg(c, fmi2Error, "%s is not available: the instance was instantiated for %s", fn,
+           c->type == fmi2CoSimulation ? "Co-Simulation" : "Model Exchange");
+    return 0;
+  }
+  if (!(mask & IN(c->state))) {
+    logmsg(c, fmi2Error, "%s called in %s, where FMI 2.0 does not allow it", fn, STATE_NAME[c->state]);
+    return 0;
+  }
+  return 1;
+}
+#define GUARD(mask, only, fn) do { if (!allowed(c, (mask), (only), (fn))) return fmi2Error; } while (0)
+
 /* ---- calls into the generated functions ----------------------------------------------------- */
 static int call_model(Instance *c, ModelFunction f, const double *x, const double *u, const double *t, double *out) {
   c->arg[0] = x; c->arg[1] = u; c->arg[2] = c->v; c->arg[3] = t; c->arg[4] = c->hoist;
@@ -135,8 +167,12 @@ static fmi2Status update_all(Instance *c) {
   if (call_model(c, c->vars, c->v + OFS_STATE, c->v + OFS_INPUT, &t, c->v + OFS_VAR)) return fmi2Error;
 #endif
   c->dirty = 0;
-  if (!finite_all(c->v + OFS_DER, N_STATES)) {
-    logmsg(c, fmi2Error, "non-finite state derivative at t = %g: the simulation diverged", c->time);
+  if (!finite_all(c->v + OFS_DER, N_STATES) || !finite_all(c->v + OFS_VAR, N_VARS)) {
+    logmsg(c, fmi2Error, "non-finite state derivative or variable at t = %g: the simulation diverged%s", c->time,
+           c->type == fmi2ModelExchange ? " (with Model Exchange: an explicit solver such as forward Euler diverges "
+                                          "at a step above about 2*zeta/omega of the fastest mode; use a smaller "
+                                          "step or an implicit/adaptive solver such as CVode)" : "");
+    c->state = ST_ERROR; /* latched until fmi2Reset */
     return fmi2Error;
   }
   return fmi2OK;
@@ -174,13 +210,22 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, f
                                      "GUID '%s' does not match '%s'", guid ? guid : "", MODEL_GUID);
     return NULL;
   }
+  if (type != fmi2ModelExchange && type != fmi2CoSimulation) {
+    if (cb && cb->logger) cb->logger(cb->componentEnvironment, name, fmi2Error, "logStatusError",
+                                     "fmi2Instantiate: unknown interface type %d", (int)type);
+    return NULL;
+  }
   c = (Instance *)calloc(1, sizeof(Instance));
-  if (!c) return NULL;
+  if (!c) {
+    if (cb && cb->logger) cb->logger(cb->componentEnvironment, name, fmi2Error, "logStatusError",
+                                     "fmi2Instantiate: out of memory");
+    return NULL;
+  }
   c->type = type;
   c->cb = cb;
   c->logging = logging;
   c->name = (char *)malloc(strlen(name ? name : "") + 1);
-  strcpy(c->name, name ? name : "");
+  if (c->name) strcpy(c->name, name ? name : "");
 #define WORK(F) F##_work(&a, &r, &i, &w); if (a > sz_arg) sz_arg = a; if (r > sz_res) sz_res = r; \
   if (i > sz_iw) sz_iw = i; if (w > sz_w) sz_w = w;
   WORK(FUN_ODE)
@@ -199,6 +244,13 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, f
   c->res = (double **)calloc(sz_res + 1, sizeof(double *));
   c->iw = (casadi_int *)calloc(sz_iw + 1, sizeof(casadi_int));
   c->w = (double *)calloc(sz_w + 1, sizeof(double));
+  if (!c->name || !c->arg || !c->res || !c->iw || !c->w) {
+    if (cb && cb->logger) cb->logger(cb->componentEnvironment, name, fmi2Error, "logStatusError",
+                                     "fmi2Instantiate: out of memory");
+    free(c->arg); free(c->res); free(c->iw); free(c->w); free(c->name);
+    free(c);
+    return NULL;
+  }
   reset_values(c);
   return c;
 }
@@ -214,6 +266,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component comp, fmi2Boolean tolDefined, fmi2R
                                fmi2Boolean stopDefined, fmi2Real tStop) {
   Instance *c = (Instance *)comp;
   (void)stopDefined; (void)tStop;
+  GUARD(IN(ST_INSTANTIATED), 0, "fmi2SetupExperiment");
   if (tolDefined && tol > 0) c->rtol = tol;
   c->time = t0;
   c->dirty = 1;
@@ -222,6 +275,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component comp, fmi2Boolean tolDefined, fmi2R
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component comp) {
   Instance *c = (Instance *)comp;
+  GUARD(IN(ST_INSTANTIATED), 0, "fmi2EnterInitializationMode");
   c->state = ST_INIT;
   c->dirty = 1;
   c->params_dirty = 1;
@@ -232,19 +286,24 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component comp) {
   Instance *c = (Instance *)comp;
   int i;
   fmi2Status st;
+  GUARD(IN(ST_INIT), 0, "fmi2ExitInitializationMode");
   c->dirty = 1;
   st = update_all(c);
+  if (st != fmi2OK) { c->state = ST_ERROR; return st; }
   for (i = 0; i < N_STATES; i++) c->xscale[i] = fabs(c->v[OFS_STATE + i]);
   c->state = (c->type == fmi2CoSimulation) ? ST_STEP : ST_EVENT;
   return st;
 }
 
 fmi2Status fmi2Terminate(fmi2Component comp) {
-  ((Instance *)comp)->state = ST_TERMINATED;
+  Instance *c = (Instance *)comp;
+  GUARD(IN(ST_STEP) | IN(ST_EVENT) | IN(ST_CONT), 0, "fmi2Terminate");
+  c->state = ST_TERMINATED;
   return fmi2OK;
 }
 
 fmi2Status fmi2Reset(fmi2Component comp) {
+  if (!comp) return fmi2Error;
   reset_values((Instance *)comp);
   return fmi2OK;
 }
@@ -263,6 +322,7 @@ static fmi2Status check_vr(Instance *c, fmi2ValueReference vr, int type) {
 
 static fmi2Status get_values(Instance *c, const fmi2ValueReference vr[], size_t n, double *out, int type) {
   size_t i;
+  GUARD(ANY_BUT_ERROR, 0, "fmi2Get<Type>");
   if (c->state != ST_INSTANTIATED && update_all(c) != fmi2OK) {
     for (i = 0; i < n; i++) if (vr[i] < N_TOTAL) out[i] = c->v[vr[i]];
     return fmi2Error;
@@ -276,6 +336,7 @@ static fmi2Status get_values(Instance *c, const fmi2ValueReference vr[], size_t 
 
 static fmi2Status set_values(Instance *c, const fmi2ValueReference vr[], size_t n, const double *in, int type) {
   size_t i;
+  GUARD(IN(ST_INSTANTIATED) | IN(ST_INIT) | IN(ST_STEP) | IN(ST_EVENT) | IN(ST_CONT), 0, "fmi2Set<Type>");
   for (i = 0; i < n; i++) {
     int kind;
     if (check_vr(c, vr[i], type) != fmi2OK) return fmi2Error;
@@ -351,22 +412,29 @@ fmi2Status fmi2SetString(fmi2Component comp, const fmi2ValueReference vr[], size
   return fmi2Error;
 }
 
-/* FMU state: the whole instance value array, time and input derivatives */
+/* FMU state: everything the next step depends on: the value array, time, input derivatives, the
+   tolerance and the adaptive integrator's memory (last step size, error scale of each state) */
 typedef struct {
   double v[ARRSZ(N_TOTAL)];
   double du1[ARRSZ(N_INPUTS)], du2[ARRSZ(N_INPUTS)];
-  double time;
+  double time, rtol, h_last;
+  double xscale[ARRSZ(N_STATES)];
   int state;
 } Snapshot;
 
 fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *s) {
   Instance *c = (Instance *)comp;
-  Snapshot *sn = *s ? (Snapshot *)*s : (Snapshot *)calloc(1, sizeof(Snapshot));
-  if (!sn) return fmi2Error;
+  Snapshot *sn;
+  GUARD(ANY_BUT_ERROR, 0, "fmi2GetFMUstate");
+  sn = *s ? (Snapshot *)*s : (Snapshot *)calloc(1, sizeof(Snapshot));
+  if (!sn) { logmsg(c, fmi2Error, "fmi2GetFMUstate: out of memory"); return fmi2Error; }
   memcpy(sn->v, c->v, sizeof sn->v);
   memcpy(sn->du1, c->du1, sizeof sn->du1);
   memcpy(sn->du2, c->du2, sizeof sn->du2);
+  memcpy(sn->xscale, c->xscale, sizeof sn->xscale);
   sn->time = c->time;
+  sn->rtol = c->rtol;
+  sn->h_last = c->h_last;
   sn->state = c->state;
   *s = sn;
   return fmi2OK;
@@ -375,11 +443,15 @@ fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *s) {
 fmi2Status fmi2SetFMUstate(fmi2Component comp, fmi2FMUstate s) {
   Instance *c = (Instance *)comp;
   Snapshot *sn = (Snapshot *)s;
-  if (!sn) return fmi2Error;
+  GUARD(ANY_BUT_ERROR, 0, "fmi2SetFMUstate");
+  if (!sn) { logmsg(c, fmi2Error, "fmi2SetFMUstate: no state given"); return fmi2Error; }
   memcpy(c->v, sn->v, sizeof sn->v);
   memcpy(c->du1, sn->du1, sizeof sn->du1);
   memcpy(c->du2, sn->du2, sizeof sn->du2);
+  memcpy(c->xscale, sn->xscale, sizeof c->xscale);
   c->time = sn->time;
+  c->rtol = sn->rtol;
+  c->h_last = sn->h_last;
   c->state = sn->state;
   c->dirty = 1;
   c->params_dirty = 1;
@@ -420,8 +492,10 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2ValueRefer
                                         const fmi2ValueReference vKnown[], size_t nK, const fmi2Real dvKnown[],
                                         fmi2Real dvUnknown[]) {
   Instance *c = (Instance *)comp;
-  double t = c->time;
+  double t;
   size_t i, j;
+  GUARD(LIVE, 0, "fmi2GetDirectionalDerivative");
+  t = c->time;
   if (update_calculated(c)) return fmi2Error;
   if (call_model(c, c->jac, c->v + OFS_STATE, c->v + OFS_INPUT, &t, c->jacobian)) return fmi2Error;
   for (i = 0; i < nU; i++) {
@@ -443,10 +517,16 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2ValueRefer
 }
 
 /* ---- Model Exchange ------------------------------------------------------------------------- */
-fmi2Status fmi2EnterEventMode(fmi2Component comp) { ((Instance *)comp)->state = ST_EVENT; return fmi2OK; }
+fmi2Status fmi2EnterEventMode(fmi2Component comp) {
+  Instance *c = (Instance *)comp;
+  GUARD(IN(ST_EVENT) | IN(ST_CONT), ME_ONLY, "fmi2EnterEventMode");
+  c->state = ST_EVENT;
+  return fmi2OK;
+}
 
 fmi2Status fmi2NewDiscreteStates(fmi2Component comp, fmi2EventInfo *info) {
-  (void)comp;
+  Instance *c = (Instance *)comp;
+  GUARD(IN(ST_EVENT), ME_ONLY, "fmi2NewDiscreteStates");
   info->newDiscreteStatesNeeded = fmi2False;
   info->terminateSimulation = fmi2False;
   info->nominalsOfContinuousStatesChanged = fmi2False;
@@ -456,11 +536,18 @@ fmi2Status fmi2NewDiscreteStates(fmi2Component comp, fmi2EventInfo *info) {
   return fmi2OK;
 }
 
-fmi2Status fmi2EnterContinuousTimeMode(fmi2Component comp) { ((Instance *)comp)->state = ST_CONT; return fmi2OK; }
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component comp) {
+  Instance *c = (Instance *)comp;
+  GUARD(IN(ST_EVENT), ME_ONLY, "fmi2EnterContinuousTimeMode");
+  c->state = ST_CONT;
+  return fmi2OK;
+}
 
 fmi2Status fmi2CompletedIntegratorStep(fmi2Component comp, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
                                        fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
-  (void)comp; (void)noSetFMUStatePriorToCurrentPoint;
+  Instance *c = (Instance *)comp;
+  (void)noSetFMUStatePriorToCurrentPoint;
+  GUARD(IN(ST_CONT), ME_ONLY, "fmi2CompletedIntegratorStep");
   *enterEventMode = fmi2False;
   *terminateSimulation = fmi2False;
   return fmi2OK;
@@ -468,6 +555,7 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component comp, fmi2Boolean noSetFMUS
 
 fmi2Status fmi2SetTime(fmi2Component comp, fmi2Real time) {
   Instance *c = (Instance *)comp;
+  GUARD(IN(ST_EVENT) | IN(ST_CONT), ME_ONLY, "fmi2SetTime");
   c->time = time;
   c->dirty = 1;
   return fmi2OK;
@@ -475,6 +563,7 @@ fmi2Status fmi2SetTime(fmi2Component comp, fmi2Real time) {
 
 fmi2Status fmi2SetContinuousStates(fmi2Component comp, const fmi2Real x[], size_t nx) {
   Instance *c = (Instance *)comp;
+  GUARD(IN(ST_EVENT) | IN(ST_CONT), ME_ONLY, "fmi2SetContinuousStates");
   if (nx != N_STATES) return fmi2Error;
   memcpy(c->v + OFS_STATE, x, sizeof(double) * nx);
   c->dirty = 1;
@@ -484,6 +573,7 @@ fmi2Status fmi2SetContinuousStates(fmi2Component comp, const fmi2Real x[], size_
 fmi2Status fmi2GetDerivatives(fmi2Component comp, fmi2Real dx[], size_t nx) {
   Instance *c = (Instance *)comp;
   fmi2Status st;
+  GUARD(IN(ST_INIT) | IN(ST_EVENT) | IN(ST_CONT) | IN(ST_TERMINATED), ME_ONLY, "fmi2GetDerivatives");
   if (nx != N_STATES) return fmi2Error;
   st = update_all(c);
   memcpy(dx, c->v + OFS_DER, sizeof(double) * nx);
@@ -491,21 +581,26 @@ fmi2Status fmi2GetDerivatives(fmi2Component comp, fmi2Real dx[], size_t nx) {
 }
 
 fmi2Status fmi2GetEventIndicators(fmi2Component comp, fmi2Real ind[], size_t ni) {
-  (void)comp; (void)ind;
+  Instance *c = (Instance *)comp;
+  (void)ind;
+  GUARD(IN(ST_INIT) | IN(ST_EVENT) | IN(ST_CONT) | IN(ST_TERMINATED), ME_ONLY, "fmi2GetEventIndicators");
   return ni == 0 ? fmi2OK : fmi2Error;
 }
 
 fmi2Status fmi2GetContinuousStates(fmi2Component comp, fmi2Real x[], size_t nx) {
   Instance *c = (Instance *)comp;
+  GUARD(IN(ST_INIT) | IN(ST_EVENT) | IN(ST_CONT) | IN(ST_TERMINATED), ME_ONLY, "fmi2GetContinuousStates");
   if (nx != N_STATES) return fmi2Error;
   memcpy(x, c->v + OFS_STATE, sizeof(double) * nx);
   return fmi2OK;
 }
 
+/* the state nominals declared in the Modelica sources (nominal attribute; 1 where none is declared) */
 fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component comp, fmi2Real nom[], size_t nx) {
-  size_t i;
-  (void)comp;
-  for (i = 0; i < nx; i++) nom[i] = 1.0;
+  Instance *c = (Instance *)comp;
+  GUARD(IN(ST_INSTANTIATED) | IN(ST_INIT) | IN(ST_EVENT) | IN(ST_CONT) | IN(ST_TERMINATED), ME_ONLY, "fmi2GetNominalsOfContinuousStates");
+  if (nx != N_STATES) return fmi2Error;
+  memcpy(nom, STATE_NOMINALS, sizeof(double) * nx);
   return fmi2OK;
 }
 
@@ -514,6 +609,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component comp, const fmi2ValueRefere
                                        const fmi2Integer order[], const fmi2Real value[]) {
   Instance *c = (Instance *)comp;
   size_t i;
+  GUARD(IN(ST_INSTANTIATED) | IN(ST_INIT) | IN(ST_STEP), CS_ONLY, "fmi2SetRealInputDerivatives");
   for (i = 0; i < n; i++) {
     if (vr[i] < OFS_INPUT || vr[i] >= OFS_STATE) {
       logmsg(c, fmi2Error, "value reference %u is not an input", (unsigned)vr[i]);
@@ -528,9 +624,11 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component comp, const fmi2ValueRefere
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component comp, const fmi2ValueReference vr[], size_t n,
                                         const fmi2Integer order[], fmi2Real value[]) {
+  Instance *c = (Instance *)comp;
   (void)vr; (void)order; (void)value;
+  GUARD(IN(ST_STEP), CS_ONLY, "fmi2GetRealOutputDerivatives");
   if (n == 0) return fmi2OK;
-  logmsg((Instance *)comp, fmi2Error, "output derivatives are not provided");
+  logmsg(c, fmi2Error, "output derivatives are not provided");
   return fmi2Error;
 }
 
@@ -616,7 +714,7 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real tc, fmi2Real H, fmi2Boolean n
   double step = c->v[VR_CS_STEP];
   int fail = 0;
   (void)noSetPrior;
-  if (c->state != ST_STEP) { logmsg(c, fmi2Error, "fmi2DoStep called outside step mode"); return fmi2Error; }
+  GUARD(IN(ST_STEP), CS_ONLY, "fmi2DoStep");
   if (H <= 0) return H == 0 ? fmi2OK : fmi2Error;
   memcpy(u0, c->v + OFS_INPUT, sizeof(double) * N_INPUTS);
   if (update_calculated(c)) return fmi2Error;

@@ -36,6 +36,7 @@ class Variable:
     is_output: bool = False
     minimum: float = float("-inf")
     maximum: float = float("inf")
+    nominal: float | None = None  # the declared nominal magnitude (states: the importer's error scale)
 
 
 @dataclass
@@ -133,7 +134,8 @@ def load(library: pathlib.Path, model_name: str) -> FlatModel:
                 description=descriptions.get(name, ""),
                 start=float(start) if isinstance(start, (int, float)) else 0.0,
                 value=v.value, python_type=v.python_type, is_output=name in outputs,
-                minimum=_bound(v, "min", float("-inf")), maximum=_bound(v, "max", float("inf"))))
+                minimum=_bound(v, "min", float("-inf")), maximum=_bound(v, "max", float("inf")),
+                nominal=_nominal(v)))
     der_symbols = {s.symbol.name(): d.symbol for s, d in zip(model.states, model.der_states)}
     if model.initial_equations:
         raise ModelicaError(f"{model_name}: initial equations are not supported; give start values")
@@ -157,6 +159,17 @@ def _bound(v, attr: str, default: float) -> float:
     """A numeric min/max attribute of a pymoca variable, or the default when absent or symbolic."""
     value = getattr(v, attr, None)
     return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else default
+
+
+def _nominal(v) -> float | None:
+    """The declared nominal of a pymoca variable (pymoca: 0 when none is declared; aliases give the largest)."""
+    value = getattr(v, "nominal", None)
+    if isinstance(value, (ca.MX, ca.SX, ca.DM)):
+        if isinstance(value, ca.DM) or value.is_constant():
+            value = float(ca.evalf(value)) if not isinstance(value, ca.DM) else float(value)
+        else:
+            return None
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) and value > 0 else None
 
 
 def _fix_self_references(variables: list[Variable], model_name: str) -> None:

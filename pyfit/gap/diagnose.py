@@ -6,6 +6,7 @@ from __future__ import annotations
 import hashlib
 import json
 import pathlib
+import time
 from dataclasses import asdict, dataclass, fields
 
 
@@ -153,6 +154,14 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     pyfit.io.nominal); None: the FMU's defaults (for the damper, the design 1.3 reference damper)."""
     from pyfit.gap import report
 
+    stage_s, clock = {}, time.perf_counter()
+
+    def stage(name):  # wall time of the stage that ends here [s]
+        nonlocal clock
+        now = time.perf_counter()
+        stage_s[name] = now - clock
+        clock = now
+
     cfg = cfg or DiagnoseConfig()
     fmu = str(ensure_fmu(family_fmu(model), pathlib.Path(fmu_dir)))
     runner = FmuRunner(fmu)
@@ -170,6 +179,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         raise DiagnoseError(f"{data_dir}: the inputs excite {lo:.1f}-{hi:.1f} Hz but the nominal model's resonances "
                             f"are at {', '.join(f'{m.f_n:.1f}' for m in modes)} Hz; allowed: an excitation band "
                             "that holds at least one resonance (the data cannot calibrate the model otherwise)")
+    stage("reading and checking the data")
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)
     judging = ("min_gap", "noise_factor", "close_points", "min_shrink_pct", "explain_factor", "explain_margin",
@@ -184,6 +194,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     if nominal is None:
         task = nominal_task(system, fmu, cal, cfg.nominal_budget, cfg.upsample)
         nominal = _fit_and_store((task, out / "fits" / "nominal.json", key))
+    stage("nominal calibration")
     deflections = []
     for r in cal:
         moved = sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods,
@@ -196,6 +207,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     sims = {"nominal": {r.name: sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods) for r in records}}
     bands = [tuple(b) for b in cfg.bands_hz] if cfg.bands_hz else localise.default_bands(records)
     gap = report.nominal_gap(sims["nominal"], records, held, bands, cfg)
+    stage("where (nominal gap)")
     screening, fits = {}, {}
     effects = cfg.effects or list(system.effects)
     # nothing to attribute when the nominal model fits the held-out files within their noise, or does not fit
@@ -209,6 +221,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
             screening, strengths = screen(system, fmu, cal, nominal, scale, cfg.upsample, effects)
             screening_path.write_text(json.dumps({"key": key, "fractions": screening, "strengths": strengths},
                                                  indent=1))
+        stage("screening")
         jobs = []
         for name in effects:
             path = out / "fits" / f"{name}.json"
@@ -221,8 +234,11 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         for name, f in fits.items():  # an effect is judged on the held-out files only
             sims[name] = {r.name: sim.simulate(runner, r, f.params, cfg.upsample, system.lead_periods)
                           for r in held}
+        stage("refits with each effect")
     result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap)
     result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample, system.lead_periods)
     runner.close()
+    stage("verdict")
+    result["stage_s"] = stage_s
     report.write(result, records, held, sims, bands, out)
     return result

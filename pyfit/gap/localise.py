@@ -43,8 +43,10 @@ def _noise_variance(rec: Record, y: np.ndarray) -> tuple[float, str]:
       upper bound: distortion lands there too);
     - 'quiet band': white noise level from the output PSD between 2x the highest excited frequency and
       0.4 fs (median over the bins, so that harmonic lines there do not count), when that band exists;
-    - 'coherence': otherwise the output power not coherent with the input over the excited band (an upper
-      bound: nonlinear distortion is not coherent either)."""
+    - 'local polynomial': otherwise the local polynomial method (Pintelon & Schoukens) on the record's DFT:
+      around every line the output is fitted as a smooth FRF times the input plus a smooth transient term
+      (polynomials of degree 2 over 13 neighbouring lines); the residual power is the noise (an upper
+      bound: nonlinear distortion of a random input is noise-like and counts too)."""
     u = rec.compared(next(iter(rec.inputs)))
     spp = rec.samples_per_period
     if spp and rec.n // spp >= 2:
@@ -66,27 +68,61 @@ def _noise_variance(rec: Record, y: np.ndarray) -> tuple[float, str]:
     quiet = (f >= 2 * f_hi) & (f <= 0.4 * rec.fs)
     if quiet.sum() >= 8:
         return float(np.median(pyy[quiet]) * rec.fs / 2), "quiet band"
-    _, coh = scipy.signal.coherence(u, y, rec.fs, nperseg=int(seg * rec.fs))
-    band = np.zeros(len(f), bool)
-    band[on] = True
-    df = f[1] - f[0]
-    return float(np.sum((1 - coh[band]) * pyy[band]) * df), "coherence"
+    return local_polynomial_noise(u, y), "local polynomial"
 
 
-def noise_estimate(rec: Record) -> tuple[float, str]:
-    """The record's noise floor as an NRMSE (over its output channels) and the method used (see
-    _noise_variance); never below the writer's rounding, so never zero."""
-    out, methods = [], []
-    for y in rec.outputs.values():
-        var, method = _noise_variance(rec, y)
-        out.append(max(var, _resolution_variance(y)) / np.mean(y**2))
-        methods.append(method)
-    return float(np.sqrt(np.mean(out))), methods[0]
+def local_polynomial_noise(u: np.ndarray, y: np.ndarray, degree: int = 2, half_width: int = 6) -> float:
+    """Noise variance of y (its unit squared) from one non-periodic record: at every DFT line k, Y(k+r) =
+    G(r) U(k+r) + T(r) + V(k+r) over r = -half_width..half_width, with G and T polynomials of `degree` in r
+    (the FRF and the leakage/transient term, both smooth); the least-squares residual, divided by its
+    degrees of freedom, estimates E|V(k)|^2. Summed over the lines it gives the time-domain variance
+    (Parseval). Unlike a coherence, this is free of the leakage bias of a lightly damped resonance."""
+    U, Y = np.fft.rfft(u), np.fft.rfft(y)
+    r = np.arange(-half_width, half_width + 1)
+    powers = r[:, None] ** np.arange(degree + 1)[None, :]  # (lines, degree + 1)
+    centres = np.arange(half_width, len(Y) - half_width)
+    idx = centres[:, None] + r[None, :]
+    A = np.concatenate([U[idx][:, :, None] * powers[None], np.broadcast_to(powers, idx.shape + powers.shape[1:])],
+                       axis=2).astype(complex)
+    b = Y[idx][:, :, None]
+    coef = np.linalg.pinv(A) @ b
+    resid = b - A @ coef
+    dof = len(r) - A.shape[2]
+    var_k = np.sum(np.abs(resid[:, :, 0]) ** 2, axis=1) / dof  # E|V(k)|^2 at the centre lines
+    n = len(y)
+    # Parseval for the one-sided DFT: var = (|V_0|^2 + 2 sum_k |V_k|^2) / n^2; lines at the edges take the
+    # mean level of their neighbours
+    return float(2 * np.mean(var_k) * len(Y) / n**2)
 
 
-def noise_floor(rec: Record) -> float:
-    """The record's noise floor as an NRMSE (see noise_estimate)."""
-    return noise_estimate(rec)[0]
+UPPER_BOUNDS = ("unexcited lines", "quiet band", "local polynomial")  # methods that count distortion as noise too
+
+
+def noise_estimates(records: list[Record]) -> dict[str, tuple[float, str]]:
+    """Each record's noise floor as an NRMSE (over its output channels) and the method used (see
+    _noise_variance); never below the writer's rounding, so never zero.
+
+    Where a method is an upper bound that also counts nonlinear distortion (UPPER_BOUNDS), a channel's noise
+    variance is the smallest that method gives over the dataset's records: sensor noise does not grow with
+    the excitation level, distortion does, so the lowest level bounds the noise of all (method marked
+    'lowest level')."""
+    per = {r.name: {k: _noise_variance(r, y) for k, y in r.outputs.items()} for r in records}
+    lowest = {}
+    for r in records:
+        for k, (var, method) in per[r.name].items():
+            if method in UPPER_BOUNDS:
+                lowest[k] = min(lowest.get(k, np.inf), var)
+    out = {}
+    for r in records:
+        ratios, methods = [], []
+        for k, y in r.outputs.items():
+            var, method = per[r.name][k]
+            if method in UPPER_BOUNDS and len(records) > 1:
+                var, method = lowest[k], f"{method}, lowest level"
+            ratios.append(max(var, _resolution_variance(y)) / np.mean(y**2))
+            methods.append(method)
+        out[r.name] = (float(np.sqrt(np.mean(ratios))), methods[0])
+    return out
 
 
 def by_band(sim: dict, rec: Record, bands: list[tuple[float, float]]) -> list[float]:

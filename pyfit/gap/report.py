@@ -16,9 +16,9 @@ def _rms_over(values) -> float:
     return float(np.sqrt(np.mean(np.square(values))))
 
 
-def _gap(sims: dict, records, held, bands) -> dict:
+def _gap(sims: dict, records, held, bands, floors: dict) -> dict:
     """Gap metrics of one model's simulations: held-out overall, per band, channel, harmonic class, loop
-    region; per level over every file."""
+    region; per level over every file (with its noise floor from `floors`, see localise.noise_estimates)."""
     hs = [r for r in held if sims[r.name] is not None]
     failed = [r.name for r in held if sims[r.name] is None]
     overall = _rms_over([localise.nrmse(sims[r.name], r) for r in hs]) if hs else float("inf")
@@ -33,7 +33,7 @@ def _gap(sims: dict, records, held, bands) -> dict:
         "by_band": [{"band_hz": list(b), "nrmse": float(v)} for b, v in zip(bands, by_band)],
         "by_level": [{"file": r.name, "level": r.level, "level_value": r.level_value, "held_out": r in held,
                       "nrmse": None if sims[r.name] is None else localise.nrmse(sims[r.name], r),
-                      "noise_floor": localise.noise_floor(r)} for r in records],
+                      "noise_floor": floors[r.name][0]} for r in records],
         "by_channel": {k: _rms_over([np.sqrt(np.mean((sims[r.name][k] - r.outputs[k]) ** 2) / np.mean(r.outputs[k] ** 2))
                                      for r in hs]) for k in records[0].outputs} if hs else {},
         "by_harmonic": {c: {q: _rms_over([h[c][q] for h in harmonic]) for q in ("misfit", "noise")}
@@ -54,8 +54,9 @@ def _free_values(fit) -> dict:
 def nominal_gap(sims: dict, records, held, bands, cfg) -> dict:
     """The nominal model's gap (where), its noise floor from the held-out data, and whether the gap is
     significant: larger than noise_factor x the floor and than the floor + min_gap."""
-    gap = _gap(sims, records, held, bands)
-    estimates = [localise.noise_estimate(r) for r in held]
+    floors = localise.noise_estimates(records)
+    gap = _gap(sims, records, held, bands, floors)
+    estimates = [floors[r.name] for r in held]
     floor = _rms_over([e[0] for e in estimates])
     gap["noise_floor"] = floor
     gap["noise_floor_method"] = sorted({e[1] for e in estimates})

@@ -38,6 +38,10 @@ RESULTS = {
                                           "--out results/boucwen_benchmark"),
     "docs/results/bench_batch_speedup.md": ("results/bench/batch_speedup.md", "python bench/batch_speedup.py"),
     "docs/results/bench_fmu_soak.md": ("results/bench/fmu_soak.md", "python bench/fmu_soak.py"),
+    "docs/results/bench_eval_speed.md": ("results/bench/eval_speed.md", "python bench/eval_speed.py"),
+    "docs/results/bench_diagnose_time.md": ("results/bench/diagnose_time.md", "python bench/diagnose_time.py"),
+    "docs/results/bench_importer_tolerance.md": ("results/bench/importer_tolerance.md",
+                                                 "python bench/importer_tolerance.py"),
 }
 
 

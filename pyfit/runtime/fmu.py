@@ -3,8 +3,10 @@
 Co-simulation runs are driven here (not by fmpy.simulate_fmu) so that the input derivatives of a
 sampled input reach the FMU: fmpy 0.3.32's simulate_fmu(set_input_derivatives=True) only works for
 FMUs with exactly nine real inputs (a fixed-size buffer). Between two samples the input is linear,
-and its slope is sent with fmi2SetRealInputDerivatives. Model Exchange runs use fmpy's CVode driver,
-which applies inputs at communication points only.
+and its slope is sent with fmi2SetRealInputDerivatives. The communication loop runs in C
+(pyfit/runtime/cs_driver.c through the FMU's own FMI functions, see pyfit.runtime.native), or in Python
+where no C compiler is available. Model Exchange runs use fmpy's CVode driver, which applies inputs at
+communication points only.
 """
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ model BoucWen "Classic Bouc-Wen hysteretic element: f = z, dz/dt = alpha*v - bet
   parameter Real gamma = 0.8 "Shape parameter multiplying |v|*|z|^(nu-1)*z";
   parameter Real delta = -1.1 "Shape parameter multiplying v*|z|^nu";
   parameter Real nu = 1 "Exponent controlling the sharpness of the transition (nu >= 1)";
-  Real z(unit="N", start=0) "Hysteretic force";
+  Real z(unit="N", start=0, nominal=1) "Hysteretic force";
 equation
   der(z) = alpha*v_rel - beta*(gamma*abs(v_rel)*sign(z)*abs(z)^nu + delta*v_rel*abs(z)^nu);
   f = z;

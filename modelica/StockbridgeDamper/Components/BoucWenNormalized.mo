@@ -8,7 +8,7 @@ model BoucWenNormalized "Normalised Bouc-Wen element: f = k_bw*(a_bw*s_rel + (1 
   parameter Real gamma(unit="1") = 0.4 "Shape parameter multiplying v*|z|^nu";
   parameter Real nu(unit="1") = 1 "Exponent controlling the sharpness of the transition (nu >= 1)";
   parameter Real D(unit="m") = 1e-3 "Yield-like displacement scale";
-  Real z(unit="1", start=0) "Dimensionless hysteretic variable";
+  Real z(unit="1", start=0, nominal=1) "Dimensionless hysteretic variable";
 equation
   der(z) = (A*v_rel - beta*abs(v_rel)*sign(z)*abs(z)^nu - gamma*v_rel*abs(z)^nu)/D;
   f = k_bw*(a_bw*s_rel + (1 - a_bw)*D*z);

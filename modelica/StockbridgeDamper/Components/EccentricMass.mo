@@ -7,10 +7,10 @@ model EccentricMass "Rigid end mass on a rigid link: centre offset a from the no
   parameter Real alpha_pd(unit="1/s") = 0 "Mass-proportional Rayleigh damping coefficient";
   Interfaces.BeamFlange flange "Node the mass is attached to";
   Interfaces.BeamFlange support "Reference frame of the damping (connect to the clamp): damping acts on the velocity relative to its vertical motion and its reaction acts on it";
-  Real x(unit="m", start=0) "Vertical displacement of the node";
-  Real phi(unit="rad", start=0) "Rotation of the node";
-  Real v(unit="m/s", start=0) "Vertical velocity of the node";
-  Real w(unit="rad/s", start=0) "Angular velocity of the node";
+  Real x(unit="m", start=0, nominal=1e-4) "Vertical displacement of the node";
+  Real phi(unit="rad", start=0, nominal=1e-3) "Rotation of the node";
+  Real v(unit="m/s", start=0, nominal=1e-2) "Vertical velocity of the node";
+  Real w(unit="rad/s", start=0, nominal=1e-1) "Angular velocity of the node";
   Real acc(unit="m/s2") "Vertical acceleration of the node";
   Real alp(unit="rad/s2") "Angular acceleration of the node";
   Real xg(unit="m") "Vertical displacement of the centre of mass";

@@ -7,10 +7,10 @@ model EulerBernoulliBeam "Planar Euler-Bernoulli beam element: consistent mass a
   parameter Real alpha_pd(unit="1/s") = 0 "Mass-proportional Rayleigh damping coefficient";
   parameter Real beta_pd(unit="s") = 0 "Stiffness-proportional Rayleigh damping coefficient";
   Interfaces.BeamFlange support "Reference frame of the damping (connect to the clamp): mass-proportional damping acts on velocities relative to its vertical motion and its reaction acts on it";
-  Real va(unit="m/s", start=0) "Vertical velocity of node a";
-  Real wa(unit="rad/s", start=0) "Angular velocity of node a";
-  Real vb(unit="m/s", start=0) "Vertical velocity of node b";
-  Real wb(unit="rad/s", start=0) "Angular velocity of node b";
+  Real va(unit="m/s", start=0, nominal=1e-2) "Vertical velocity of node a";
+  Real wa(unit="rad/s", start=0, nominal=1e-1) "Angular velocity of node a";
+  Real vb(unit="m/s", start=0, nominal=1e-2) "Vertical velocity of node b";
+  Real wb(unit="rad/s", start=0, nominal=1e-1) "Angular velocity of node b";
   Real aa(unit="m/s2") "Vertical acceleration of node a";
   Real ala(unit="rad/s2") "Angular acceleration of node a";
   Real ab(unit="m/s2") "Vertical acceleration of node b";

@@ -15,10 +15,10 @@ model ConductorSpan "Laboratory conductor span: taut string between rigid ends, 
   output Real a_d(unit="m/s2") "Span acceleration at the damper clamp";
   output Real y_e(unit="m") "Span displacement at the shaker";
   output Real E(unit="J") "Mechanical energy of the span (modal kinetic + potential) and the clamp's kinetic energy";
-  output Real W_self(unit="J") "Energy dissipated by the span's self-damping since t = 0";
-  output Real W_shaker(unit="J") "Work done by the shaker force since t = 0";
-  Real q[N](each unit="m", each start=0) "Modal displacements (antinode amplitudes)";
-  Real qd[N](each unit="m/s", each start=0) "Modal velocities";
+  output Real W_self(unit="J", nominal=1e-3) "Energy dissipated by the span's self-damping since t = 0";
+  output Real W_shaker(unit="J", nominal=1e-3) "Work done by the shaker force since t = 0";
+  Real q[N](each unit="m", each start=0, each nominal=1e-5) "Modal displacements (antinode amplitudes)";
+  Real qd[N](each unit="m/s", each start=0, each nominal=1e-3) "Modal velocities";
   Real phi_d[N](each unit="1") "Mode shapes at the clamp";
   Real phi_e[N](each unit="1") "Mode shapes at the shaker";
   Real w[N](each unit="rad/s") "Natural circular frequencies";
