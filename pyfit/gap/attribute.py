@@ -5,6 +5,7 @@ calibration records, in parameters scaled to their bounds."""
 from __future__ import annotations
 
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -46,18 +47,26 @@ class FitTask:
     upsample: int
     lead_periods: int = 1
     alternatives: tuple = ()  # other starts (dicts of parameter overrides): the least squares starts from the best
+    threads: int = 1  # records simulated at once (one FMU instance each; the compiled loop releases the GIL)
 
 
-def _stacked(runner, records, params: dict, upsample: int, lead_periods: int) -> np.ndarray:
-    """The calibration records' residuals, stacked."""
-    return np.concatenate([sim.residuals(sim.simulate(runner, r, params, upsample, lead_periods), r)
-                           for r in records])
+def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, pool=None) -> np.ndarray:
+    """The calibration records' residuals, stacked. runner: one FmuRunner, or one per record when `pool` (a
+    thread pool) simulates the records at once; the result is the same either way."""
+    runners = runner if isinstance(runner, list) else [runner] * len(records)
+
+    def one(k):
+        return sim.residuals(sim.simulate(runners[k], records[k], params, upsample, lead_periods), records[k])
+
+    return np.concatenate(list(pool.map(one, range(len(records))) if pool else map(one, range(len(records)))))
 
 
 def run_fit(task: FitTask) -> Fit:
     """Least squares on the stacked calibration residuals from task.start within task.bounds."""
     t0 = time.perf_counter()
-    runner = FmuRunner(task.fmu)
+    threads = max(1, min(task.threads, len(task.records)))
+    runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
+    pool = ThreadPoolExecutor(threads) if threads > 1 else None
     names = list(task.start)
     lo = np.array([task.bounds[n][0] for n in names])
     hi = np.array([task.bounds[n][1] for n in names])
@@ -66,7 +75,7 @@ def run_fit(task: FitTask) -> Fit:
         return {**task.fixed, **dict(zip(names, lo + np.clip(x, 0, 1) * (hi - lo)))}
 
     def residuals(p):
-        return _stacked(runner, task.records, p, task.upsample, task.lead_periods)
+        return _stacked(runner, task.records, p, task.upsample, task.lead_periods, pool)
 
     def scaled(start):
         return np.clip((np.array([start[n] for n in names]) - lo) / (hi - lo), 0.0, 1.0)
@@ -80,7 +89,10 @@ def run_fit(task: FitTask) -> Fit:
     result = polish(lambda x: residuals(params(x)), x0, budget=task.budget)
     best = params(result.x)
     err = float(np.sqrt(result.error / len(task.records)))
-    runner.close()
+    for r in runner if isinstance(runner, list) else [runner]:
+        r.close()
+    if pool:
+        pool.shutdown()
     return Fit(task.effect, {k: float(v) for k, v in best.items()}, names, task.n_added, err,
                result.n_evaluations + scanned, time.perf_counter() - t0)
 
@@ -89,9 +101,10 @@ STIFFNESS_SCAN = (0.25, 0.5, 1.0, 2.0, 4.0)  # factors on the nominal stiffness 
 STRENGTH_FACTORS = (0.25, 0.5, 1.0)  # factors on the screening's Gauss-Newton effect strength tried likewise
 
 
-def nominal_task(system: System, fmu: str, records: list, budget: int, upsample: int) -> FitTask:
+def nominal_task(system: System, fmu: str, records: list, budget: int, upsample: int, threads: int = 1) -> FitTask:
     """The nominal (linear) calibration: from the system's start (the SDOF: its measured FRF; the damper: the
-    described values), the best of the stiffness scaled by STIFFNESS_SCAN, then least squares."""
+    described values), the best of the stiffness scaled by STIFFNESS_SCAN, then least squares; `threads`
+    records simulated at once (it runs alone, so it may use every core)."""
     start = system.start(records)
     bounds = system.bounds(start)
     scan = system.stiffness in start
@@ -102,7 +115,7 @@ def nominal_task(system: System, fmu: str, records: list, budget: int, upsample:
     alternatives = tuple({system.stiffness: start[system.stiffness] * f} for f in STIFFNESS_SCAN if f != 1.0) \
         if scan else ()
     return FitTask(fmu, tuple(records), dict(system.nominal_fixed), {n: start[n] for n in system.linear},
-                   bounds, "nominal", 0, budget, upsample, system.lead_periods, alternatives)
+                   bounds, "nominal", 0, budget, upsample, system.lead_periods, alternatives, threads)
 
 
 def effect_start(system: System, effect: Effect, scale: Scale, nominal: dict) -> tuple[dict, dict, dict]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import pathlib
 import time
 from dataclasses import asdict, dataclass, fields
@@ -192,7 +193,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
 
     nominal = _stored(out / "fits" / "nominal.json", key)
     if nominal is None:
-        task = nominal_task(system, fmu, cal, cfg.nominal_budget, cfg.upsample)
+        task = nominal_task(system, fmu, cal, cfg.nominal_budget, cfg.upsample,
+                            threads=workers or os.cpu_count() or 1)
         nominal = _fit_and_store((task, out / "fits" / "nominal.json", key))
     stage("nominal calibration")
     deflections = []
