@@ -78,28 +78,21 @@ def ecos_run(fmu, outputs, ints, reals, stop):
     return np.array(rows)
 
 
-@pytest.mark.parametrize("name", list(CASES))
-def test_libcosim_runs_the_fmu_as_fmpy_does(fmu_dir, name, measured):
-    outputs, ints, reals, stop = CASES[name]
-    fmu = fmu_dir / f"{name}.fmu"
-    ref = reference(fmu, outputs, ints, reals, stop)
-    got = libcosim_run(fmu, outputs, ints, reals, stop)
-    for j, o in enumerate(outputs):
-        y = ref[o][1:]
-        diff = float(np.max(np.abs(got[:, j] - y)) / np.max(np.abs(y)))
-        measured(f"libcosim vs fmpy, {name}.{o}: max difference / max |{o}|", diff, 1e-9)
+IMPORTERS = {"libcosim": (libcosim_run, lambda: ""), "Ecos": (ecos_run, ecos_loadable)}
 
 
+@pytest.mark.parametrize("importer", list(IMPORTERS))
 @pytest.mark.parametrize("name", list(CASES))
-def test_ecos_runs_the_fmu_as_fmpy_does(fmu_dir, name, measured):
-    why = ecos_loadable()
+def test_importer_runs_the_fmu_as_fmpy_does(fmu_dir, name, importer, measured):
+    run, unavailable = IMPORTERS[importer]
+    why = unavailable()
     if why:
         pytest.skip(why)
     outputs, ints, reals, stop = CASES[name]
     fmu = fmu_dir / f"{name}.fmu"
     ref = reference(fmu, outputs, ints, reals, stop)
-    got = ecos_run(fmu, outputs, ints, reals, stop)
+    got = run(fmu, outputs, ints, reals, stop)
     for j, o in enumerate(outputs):
         y = ref[o][1:]
         diff = float(np.max(np.abs(got[:, j] - y)) / np.max(np.abs(y)))
-        measured(f"Ecos vs fmpy, {name}.{o}: max difference / max |{o}|", diff, 1e-9)
+        measured(f"{importer} vs fmpy, {name}.{o}: max difference / max |{o}|", diff, 1e-9)

@@ -73,8 +73,8 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
     for name in fits:
         done = [localise.nrmse(sims[name][r.name], r) for r in held if sims[name][r.name] is not None]
         afters[name] = _rms_over(done) if len(done) == len(held) else float("inf")
-    # the floor estimated from the data is an upper bound where it rests on coherence or unexcited lines; so
-    # is any model's held-out misfit: the shrink is measured against the smaller of the two
+    # the floor is an upper bound where distortion counts as noise (localise.UPPER_BOUNDS); so is any model's
+    # held-out misfit: the shrink is measured against the smaller of the two
     reference = min([floor] + list(afters.values()))
     gap["shrink_reference"] = reference
     ranking = []

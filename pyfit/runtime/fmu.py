@@ -223,14 +223,13 @@ class FmuRunner:
             tol = 1e-6 * np.min(np.diff(it))
             idx = np.clip(np.searchsorted(it, time + tol, side="right") - 1, 0, len(it) - 2)
             slope = (table[:, idx + 1] - table[:, idx]) / (it[idx + 1] - it[idx])
-            in_buf = (ctypes.c_double * k)()
-            der_buf = (ctypes.c_double * k)()
-            order = (ctypes.c_int * k)(*([1] * k))
         loop = cs_loop()
         if loop is not None:
             self._run_cs_compiled(loop, fmu, time, out_vr, result, in_vr if k else None,
                                   u_at if k else None, None if (hold_inputs or not k) else slope)
-        else:
+        else:  # the same loop in Python
+            in_buf, der_buf = (ctypes.c_double * k)(), (ctypes.c_double * k)()
+            order = (ctypes.c_int * k)(*([1] * k))
             get_real, do_step = fmu.fmi2GetReal, fmu.fmi2DoStep
             set_real, set_der = fmu.fmi2SetReal, fmu.fmi2SetRealInputDerivatives
             comp = fmu.component
