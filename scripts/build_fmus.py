@@ -1,4 +1,4 @@
-"""Build every example of modelica/ into fmus/ (FMI 2.0 Model Exchange + Co-Simulation).
+"""Build every example of modelica/ into fmus/ (FMI 2.0) and fmus/fmi3/ (FMI 3.0), Model Exchange + Co-Simulation.
 
     python scripts/build_fmus.py [--out fmus] [NAME ...]
 """
@@ -19,7 +19,7 @@ def main() -> int:
     args = ap.parse_args()
     try:
         build_all(pathlib.Path(args.out), args.names or None, pathlib.Path(args.library),
-                  on_built=lambda r: print(f"built {r.fmu} ({r.n_states} states)"))
+                  on_built=lambda r: print(f"built {r.fmu} and {r.fmu3} ({r.n_states} states)"))
     except (ModelicaError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

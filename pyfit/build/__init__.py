@@ -1,4 +1,5 @@
-"""Modelica -> FMU build: pymoca front end -> index reduction -> CasADi C code -> FMI 2.0 wrapper -> gcc -> zip.
+"""Modelica -> FMU build: pymoca front end -> index reduction -> CasADi C code -> FMI 2.0 wrapper (+ FMI 3.0
+adapter) -> gcc -> zip.
 
 The .mo files are the single source of truth: nothing here knows any model's equations.
 """
@@ -10,7 +11,7 @@ from dataclasses import dataclass
 
 from pyfit.build.catalog import EXAMPLES, LIBRARY, ModelicaError
 
-__all__ = ["ModelicaError", "EXAMPLES", "build_fmu", "build_all", "LIBRARY"]
+__all__ = ["ModelicaError", "EXAMPLES", "build_fmu", "build_all", "fmi3_path", "LIBRARY"]
 
 
 @dataclass
@@ -20,11 +21,18 @@ class BuildResult:
     fmu: pathlib.Path
     n_states: int
     demoted_states: list[str]
+    fmu3: pathlib.Path  # the FMI 3.0 FMU of the same model
+
+
+def fmi3_path(out_dir: pathlib.Path, ident: str) -> pathlib.Path:
+    """Where the FMI 3.0 FMU of `ident` goes: <out_dir>/fmi3/<ident>.fmu (beside the FMI 2.0 one)."""
+    return pathlib.Path(out_dir) / "fmi3" / f"{ident}.fmu"
 
 
 def build_fmu(model_name: str, out_dir: pathlib.Path, ident: str | None = None,
               library: pathlib.Path = LIBRARY) -> BuildResult:
-    """Build one Modelica class into `<out_dir>/<ident>.fmu` (FMI 2.0, Model Exchange + Co-Simulation)."""
+    """Build one Modelica class into `<out_dir>/<ident>.fmu` (FMI 2.0) and `<out_dir>/fmi3/<ident>.fmu` (FMI 3.0),
+    both Model Exchange + Co-Simulation, from the same generated C sources."""
     from pyfit.build import codegen, frontend, package, reduce  # the compiler loads only when building
 
     ident = ident or model_name.split(".")[-1]
@@ -35,9 +43,14 @@ def build_fmu(model_name: str, out_dir: pathlib.Path, ident: str | None = None,
     with tempfile.TemporaryDirectory() as tmp:
         src = pathlib.Path(tmp) / "sources"
         sources = codegen.write_sources(model, ident, guid, variables, src)
-        xml = codegen.model_description(model, ident, guid, variables, sources)
-        fmu = package.compile_and_zip(ident, src, xml, pathlib.Path(out_dir) / f"{ident}.fmu")
-    return BuildResult(fmu, len(model.states), model.demoted)
+        documents = {
+            "2.0": {"modelDescription.xml": codegen.model_description(model, ident, guid, variables, sources)},
+            "3.0": {"modelDescription.xml": codegen.model_description_fmi3(model, ident, guid, variables),
+                    "sources/buildDescription.xml": codegen.build_description_fmi3(ident, sources + [
+                        package.FMI3_ADAPTER.name])}}
+        fmus = package.compile_and_zip(ident, src, documents, {"2.0": pathlib.Path(out_dir) / f"{ident}.fmu",
+                                                               "3.0": fmi3_path(out_dir, ident)})
+    return BuildResult(fmus["2.0"], len(model.states), model.demoted, fmus["3.0"])
 
 
 def build_all(out_dir: pathlib.Path, names: list[str] | None = None, library: pathlib.Path = LIBRARY,

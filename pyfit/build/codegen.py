@@ -1,4 +1,4 @@
-"""Explicit model -> C sources (CasADi code generator) and the FMI 2.0 modelDescription.xml."""
+"""Explicit model -> C sources (CasADi code generator) and the FMI 2.0 and 3.0 modelDescription.xml."""
 from __future__ import annotations
 
 import hashlib
@@ -176,6 +176,36 @@ def _fmt(x: float) -> str:
     return repr(float(x)) if math.isfinite(x) else ("1e300" if x > 0 else "-1e300")
 
 
+def _units_and_experiment(root: ET.Element, model: ExplicitModel, variables: list[FmuVariable]) -> None:
+    units = sorted({v.unit for v in variables if v.unit})
+    if units:
+        ud = ET.SubElement(root, "UnitDefinitions")
+        for u in units:
+            ET.SubElement(ud, "Unit", {"name": u})
+    exp = model.experiment
+    if exp:
+        attrs = {k: _fmt(exp[k2]) for k, k2 in (("startTime", "StartTime"), ("stopTime", "StopTime"),
+                                                 ("tolerance", "Tolerance"), ("stepSize", "Interval")) if k2 in exp}
+        ET.SubElement(root, "DefaultExperiment", attrs)
+
+
+def _bounds_and_start(v: FmuVariable) -> dict[str, str]:
+    attrs = {}
+    if v.nominal:
+        attrs["nominal"] = _fmt(v.nominal)
+    for key, bound in (("min", v.minimum), ("max", v.maximum)):
+        if math.isfinite(bound):
+            attrs[key] = str(int(bound)) if v.type == "Integer" else _fmt(bound)
+    if v.start is not None:
+        attrs["start"] = str(int(v.start)) if v.type == "Integer" else _fmt(v.start)
+    return attrs
+
+
+def _xml(root: ET.Element) -> bytes:
+    ET.indent(root)
+    return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8")
+
+
 def model_description(model: ExplicitModel, ident: str, guid: str, variables: list[FmuVariable],
                       sources: list[str]) -> bytes:
     """The FMI 2.0 modelDescription.xml for an FMU with both Model Exchange and Co-Simulation."""
@@ -194,16 +224,7 @@ def model_description(model: ExplicitModel, ident: str, guid: str, variables: li
         sf = ET.SubElement(el, "SourceFiles")
         for s in sources:
             ET.SubElement(sf, "File", {"name": s})
-    units = sorted({v.unit for v in variables if v.unit})
-    if units:
-        ud = ET.SubElement(root, "UnitDefinitions")
-        for u in units:
-            ET.SubElement(ud, "Unit", {"name": u})
-    exp = model.experiment
-    if exp:
-        attrs = {k: _fmt(exp[k2]) for k, k2 in (("startTime", "StartTime"), ("stopTime", "StopTime"),
-                                                 ("tolerance", "Tolerance"), ("stepSize", "Interval")) if k2 in exp}
-        ET.SubElement(root, "DefaultExperiment", attrs)
+    _units_and_experiment(root, model, variables)
     mv = ET.SubElement(root, "ModelVariables")
     for v in variables:
         attrs = {"name": v.name, "valueReference": str(v.vr), "causality": v.causality,
@@ -219,14 +240,7 @@ def model_description(model: ExplicitModel, ident: str, guid: str, variables: li
                 tattrs["unit"] = v.unit
             if v.derivative_of is not None:
                 tattrs["derivative"] = str(v.derivative_of + 1)
-        if v.nominal:
-            tattrs["nominal"] = _fmt(v.nominal)
-        for key, bound in (("min", v.minimum), ("max", v.maximum)):
-            if math.isfinite(bound):
-                tattrs[key] = str(int(bound)) if v.type == "Integer" else _fmt(bound)
-        if v.start is not None:
-            tattrs["start"] = str(int(v.start)) if v.type == "Integer" else _fmt(v.start)
-        ET.SubElement(sv, v.type, tattrs)
+        ET.SubElement(sv, v.type, dict(tattrs, **_bounds_and_start(v)))
     ms = ET.SubElement(root, "ModelStructure")
     outputs = [v for v in variables if v.causality == "output"]
     derivs = [v for v in variables if v.derivative_of is not None]
@@ -238,11 +252,68 @@ def model_description(model: ExplicitModel, ident: str, guid: str, variables: li
         el = ET.SubElement(ms, "Derivatives")
         for v in derivs:
             ET.SubElement(el, "Unknown", {"index": str(v.vr + 1)})
-    init = sorted(outputs + derivs + [v for v in variables if v.causality == "calculatedParameter"],
-                  key=lambda v: v.vr)
+    init = _initial_unknowns(variables)
     if init:
         el = ET.SubElement(ms, "InitialUnknowns")
         for v in init:
             ET.SubElement(el, "Unknown", {"index": str(v.vr + 1)})
-    ET.indent(root)
-    return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8")
+    return _xml(root)
+
+
+def _initial_unknowns(variables: list[FmuVariable]) -> list[FmuVariable]:
+    return [v for v in variables if v.causality in ("output", "calculatedParameter") or v.derivative_of is not None]
+
+
+FMI3_TYPES = {"Real": "Float64", "Integer": "Int32"}
+
+
+def model_description_fmi3(model: ExplicitModel, ident: str, guid: str, variables: list[FmuVariable]) -> bytes:
+    """The FMI 3.0 modelDescription.xml of the same variables (value references unchanged; `time`, the
+    independent variable, is added after them), Model Exchange and Co-Simulation."""
+    root = ET.Element("fmiModelDescription", {
+        "fmiVersion": "3.0", "modelName": model.name, "instantiationToken": guid,
+        "description": model.description or model.name,
+        "generationTool": "pyfit build (pymoca front end, CasADi code generator)",
+        "variableNamingConvention": "structured"})
+    common = {"modelIdentifier": ident, "providesDirectionalDerivatives": "true",
+              "canGetAndSetFMUState": "true", "canSerializeFMUState": "true"}
+    ET.SubElement(root, "ModelExchange", dict(common, completedIntegratorStepNotNeeded="true"))
+    ET.SubElement(root, "CoSimulation", dict(common, canHandleVariableCommunicationStepSize="true",
+                                             maxOutputDerivativeOrder="0", hasEventMode="false"))
+    _units_and_experiment(root, model, variables)
+    mv = ET.SubElement(root, "ModelVariables")
+    time_vr = len(variables)
+    ET.SubElement(mv, "Float64", {"name": "time", "valueReference": str(time_vr), "causality": "independent",
+                                  "variability": "continuous", "description": "Simulation time", "unit": "s"})
+    for v in variables:
+        attrs = {"name": v.name, "valueReference": str(v.vr), "causality": v.causality,
+                 "variability": v.variability}
+        if v.description:
+            attrs["description"] = v.description
+        if v.initial:
+            attrs["initial"] = v.initial
+        if v.type == "Real" and v.unit:
+            attrs["unit"] = v.unit
+        if v.derivative_of is not None:
+            attrs["derivative"] = str(v.derivative_of)
+        ET.SubElement(mv, FMI3_TYPES[v.type], dict(attrs, **_bounds_and_start(v)))
+    ms = ET.SubElement(root, "ModelStructure")
+    for v in variables:
+        if v.causality == "output":
+            ET.SubElement(ms, "Output", {"valueReference": str(v.vr)})
+    for v in variables:
+        if v.derivative_of is not None:
+            ET.SubElement(ms, "ContinuousStateDerivative", {"valueReference": str(v.vr)})
+    for v in _initial_unknowns(variables):
+        ET.SubElement(ms, "InitialUnknown", {"valueReference": str(v.vr)})
+    return _xml(root)
+
+
+def build_description_fmi3(ident: str, sources: list[str]) -> bytes:
+    """sources/buildDescription.xml of the FMI 3.0 FMU: the C files to compile it from source."""
+    root = ET.Element("fmiBuildDescription", {"fmiVersion": "3.0"})
+    conf = ET.SubElement(root, "BuildConfiguration", {"modelIdentifier": ident})
+    files = ET.SubElement(conf, "SourceFileSet", {"language": "C99"})
+    for s in sources:
+        ET.SubElement(files, "SourceFile", {"name": s})
+    return _xml(root)

@@ -80,13 +80,17 @@ def write_docs(name: str, fmu: str | pathlib.Path, out_dir: str | pathlib.Path) 
                      f"reproduces [`{name}_ref_held.csv`]({name}_ref_held.csv) (same run, inputs held), not "
                      f"`{csv.name}`. They differ by (max |difference| / max |output|): {gaps}. To get the "
                      "linear-input result from such an importer, sample the inputs finer (the difference "
-                     "falls with the square of the step).")
+                     "falls with the square of the step). Outputs that depend directly on an input are "
+                     "recorded there as read before the next input is set; an importer that reads them after "
+                     "setting it (fmpy does) sees them with the new input. The FMI 3.0 FMU "
+                     f"(`fmus/fmi3/{name}.fmu`) always holds inputs over a step.")
     runner.close()
     lines = [f"# {name}", "", md.description or "", "",
              f"FMI {md.fmiVersion} Model Exchange and Co-Simulation, generated from "
              f"`modelica/` by `python scripts/build_fmus.py` (pyfit); GUID `{md.guid}`.",
              "Co-simulation: adaptive DOPRI5 inside each communication step (tolerance from fmi2SetupExperiment), "
-             "inputs linear over a step when their derivatives are set (canInterpolateInputs).", ""]
+             "inputs linear over a step when their derivatives are set (canInterpolateInputs). The same model "
+             f"as FMI 3.0: `fmus/fmi3/{name}.fmu`.", ""]
     lines += ["## Variables (SI units)", ""] + _table(md, "input") + _table(md, "output") + _table(md, "parameter")
     lines += ["## Reference result", "", f"[`{csv.name}`]({csv.name}): {what}; output interval {STEP} s, "
               f"{STOP} s, tolerance 1e-10, inputs linear between samples. Regenerate with "
