@@ -42,7 +42,7 @@ def test_amplitude_with_a_viscous_damper_is_the_root_of_the_balance_polynomial()
     quad = (0.5 * c.zeta * c.mass_per_length * w ** 3 * L + 0.5 * c_d * w ** 2 * s ** 2) * D ** 2 / (f ** 3 * D ** 4 * L)
     a3, a2, a1, a0 = eb.CIGRE_FNC
     eta = _first_positive_root([a3, a2 - quad, a1, a0])
-    Y = eb.steady_amplitude(f, c, lambda a: 0.5 * c_d * w ** 2 * a ** 2, x_d)
+    Y = eb.steady_amplitude(f, c, [(lambda a: 0.5 * c_d * w ** 2 * a ** 2, x_d)])
     assert Y / D == pytest.approx(eta, rel=1e-8)
     assert Y < 0.5 * eb.steady_amplitude(f, c)  # the dashpot takes most of the wind's power
 

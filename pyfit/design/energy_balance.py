@@ -10,10 +10,11 @@ puts into the span equals the power the conductor's self-damping and the damper 
   Foti F., Martinelli L. (2018), "An enhanced unified model for the self-damping of stranded cables under
   aeolian vibrations", J. Wind Eng. Ind. Aerodyn. 182, 72-86, eqs. (4)-(5) (I_v: turbulence intensity; 0 =
   smooth flow, the conservative case).
-- Self-damping: the span's viscous modal damping ζ (the same law the ConductorSpan FMU uses): a standing
-  wave of antinode amplitude Y stores ¼ m_l ω² Y² per metre, so P_self = ½ ζ m_l ω³ Y² · L.
-- Damper: the mean power the damper FMU takes when its clamp follows the undisturbed standing wave at its
-  position (F_clamp · v_clamp averaged over whole periods of the steady state), tabulated over frequency and
+- Self-damping: a published power law P/L = k Y^l f^m / T^n (`pyfit.design.conductor`), or the span's
+  viscous modal damping ζ (the same law the ConductorSpan FMU uses): a standing wave of antinode amplitude Y
+  stores ¼ m_l ω² Y² per metre, so P_self = ½ ζ m_l ω³ Y² · L.
+- Dampers (any number): the mean power the damper FMU takes when its clamp follows the undisturbed standing
+  wave at its position (F_clamp · v_clamp averaged over whole periods of the steady state), tabulated over frequency and
   clamp amplitude and interpolated log-log in amplitude.
 
 The steady amplitude is the first root of P_wind - P_self - P_damper going up from Y = 0 (vibration builds
@@ -29,9 +30,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
+from pyfit.design.conductor import PowerLaw, self_damping_power_per_length
+from pyfit.design.span import span_properties
 from pyfit.report import plots
 from pyfit.runtime.batch import RunSpec, run_batch
-from pyfit.design.span import span_properties
 
 CIGRE_FNC = (-99.73, 101.62, 0.1627, 0.2256)  # W/(m·Hz³·m⁴), polynomial in Y/D, highest power first
 ETA_MAX = 1.2  # Y/D searched up to here (the CIGRE fnc turns negative above Y/D = 1.02)
@@ -48,7 +50,8 @@ class Conductor:
     mass_per_length: float  # kg/m
     tension: float  # N
     span_length: float  # m
-    zeta: float  # self-damping ratio of every mode [-]
+    zeta: float  # viscous self-damping ratio of every mode [-]; used when self_damping is None
+    self_damping: tuple[PowerLaw, float] | None = None  # (law, k): the power law P/L = k Y^l f^m / T[kN]^n
 
     def wavelength(self, f):
         """Wavelength [m] of a travelling wave at frequency f [Hz]."""
@@ -70,7 +73,11 @@ def wind_power(f, Y, conductor: Conductor, turbulence: float = 0.0):
 
 
 def self_damping_power(f, Y, conductor: Conductor):
-    """Power [W] the span's viscous self-damping ζ dissipates at frequency f [Hz], antinode amplitude Y [m]."""
+    """Power [W] the span's self-damping dissipates at frequency f [Hz], antinode amplitude Y [m]: the
+    conductor's power law if it has one, else its viscous modal damping ζ."""
+    if conductor.self_damping is not None:
+        law, k = conductor.self_damping
+        return self_damping_power_per_length(law, k, f, Y, conductor.tension) * conductor.span_length
     w = 2 * np.pi * np.asarray(f, float)
     return 0.5 * conductor.zeta * conductor.mass_per_length * w ** 3 * np.asarray(Y, float) ** 2 \
         * conductor.span_length
@@ -87,19 +94,19 @@ class DamperPowerTable:
     power: np.ndarray
     drift: np.ndarray = field(default=None)
 
-    def at(self, i: int, a: float) -> float:
-        """Power at frequencies[i] and clamp amplitude a [m]: log-log interpolation; ∝ a² below the
-        table (the linear range); NaN above it or beyond a failed run."""
+    def at(self, i: int, a):
+        """Power [W] at frequencies[i] and clamp amplitude(s) a [m]: log-log interpolation; ∝ a² below the
+        table (the linear range); NaN above it or next to a failed run. Scalar in, float out."""
+        a = np.asarray(a, float)
         amps, p = self.amplitudes, self.power[i]
-        if a <= 0:
-            return 0.0
-        if a <= amps[0]:
-            return float(p[0] * (a / amps[0]) ** 2)
-        j = int(np.searchsorted(amps, a))
-        if j >= len(amps) or not (p[j - 1] > 0 and p[j] > 0):
-            return math.nan
-        s = math.log(a / amps[j - 1]) / math.log(amps[j] / amps[j - 1])
-        return float(math.exp((1 - s) * math.log(p[j - 1]) + s * math.log(p[j])))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            logp = np.where(p > 0, np.log(np.where(p > 0, p, 1.0)), np.nan)
+            j = np.clip(np.searchsorted(amps, a), 1, len(amps) - 1)
+            s = np.log(np.maximum(a, 1e-300) / amps[j - 1]) / np.log(amps[j] / amps[j - 1])
+            out = np.exp((1 - s) * logp[j - 1] + s * logp[j])
+            out = np.where(a <= amps[0], p[0] * (a / amps[0]) ** 2, out)
+        out = np.where(a > amps[-1], np.nan, np.where(a <= 0, 0.0, out))
+        return float(out) if out.ndim == 0 else out
 
     def save(self, path) -> None:
         """CSV: one row per frequency [Hz], one column per clamp amplitude [m], mean power [W]."""
@@ -150,28 +157,30 @@ def damper_power_table(fmu, frequencies, amplitudes, params: dict | None = None,
     return DamperPowerTable(freqs, amps, power, drift)
 
 
-def steady_amplitude(f: float, conductor: Conductor, damper_power=None, x_d: float = 0.0,
-                     turbulence: float = 0.0, n_grid: int = 400) -> float:
+def steady_amplitude(f: float, conductor: Conductor, dampers=(), turbulence: float = 0.0,
+                     n_grid: int = 400) -> float:
     """Steady antinode amplitude Y [m] at frequency f [Hz]: the first root, going up from 0, of
-    P_wind - P_self - P_damper(clamp amplitude). damper_power(a) [W] at clamp amplitude a [m] (None: no
-    damper; NaN: outside the damper table, which makes the result NaN if the root lies there)."""
+    P_wind - P_self - Σ P_damper. `dampers`: (power, x_d) pairs, power(a) [W] at clamp amplitude a [m]
+    (vectorised; NaN outside the damper's table, which makes the result NaN if the root lies there) for a
+    damper at x_d [m] from the clamp, where the undisturbed standing wave moves it by Y·|sin(2π x_d / λ)|."""
     D = conductor.diameter
-    clamp = abs(math.sin(2 * math.pi * x_d / float(conductor.wavelength(f))))
+    lam = float(conductor.wavelength(f))
+    clamps = [(power, abs(math.sin(2 * math.pi * x_d / lam))) for power, x_d in dampers]
 
     def net(Y):
-        pd = damper_power(Y * clamp) if damper_power is not None else 0.0
-        return float(wind_power(f, Y, conductor, turbulence) - self_damping_power(f, Y, conductor)) - pd
+        out = wind_power(f, Y, conductor, turbulence) - self_damping_power(f, Y, conductor)
+        for power, c in clamps:
+            out = out - power(np.asarray(Y, float) * c)
+        return out
 
-    grid = D * np.geomspace(1e-5, ETA_MAX, n_grid)
-    prev_y, prev = 0.0, net(grid[0] * 1e-3)
-    for Y in grid:
-        g = net(Y)
-        if math.isnan(g):
-            return math.nan
-        if prev > 0 >= g:
-            return brentq(net, prev_y, Y, xtol=1e-12 * D, rtol=1e-10)
-        prev_y, prev = Y, g
-    return math.nan
+    ys = np.concatenate([[0.0], D * np.geomspace(1e-5, ETA_MAX, n_grid)])
+    vals = net(np.concatenate([[ys[1] * 1e-3], ys[1:]]))
+    bad = np.flatnonzero(np.isnan(vals))
+    cross = np.flatnonzero((vals[:-1] > 0) & (vals[1:] <= 0)) + 1
+    if cross.size == 0 or (bad.size and bad[0] <= cross[0]):
+        return math.nan
+    k = cross[0]
+    return brentq(lambda y: float(net(y)), ys[k - 1], ys[k], xtol=1e-12 * D, rtol=1e-10)
 
 
 @dataclass
@@ -192,8 +201,8 @@ def energy_balance(conductor: Conductor, table: DamperPowerTable, positions, tur
     """Steady amplitudes with and without the damper at every frequency of the damper power table."""
     rows = []
     for i, f in enumerate(table.frequencies):
-        y0 = steady_amplitude(f, conductor, None, 0.0, turbulence)
-        with_damper = {x: steady_amplitude(f, conductor, lambda a, i=i: table.at(i, a), x, turbulence)
+        y0 = steady_amplitude(f, conductor, (), turbulence)
+        with_damper = {x: steady_amplitude(f, conductor, [(lambda a, i=i: table.at(i, a), x)], turbulence)
                        for x in positions}
         rows.append(BalanceRow(float(f), float(f) * conductor.diameter / STROUHAL, y0, with_damper))
     return rows

@@ -40,6 +40,8 @@ RESULTS = {
     "docs/results/bench_fmu_soak.md": ("results/bench/fmu_soak.md", "python bench/fmu_soak.py"),
     "docs/results/bench_eval_speed.md": ("results/bench/eval_speed.md", "python bench/eval_speed.py"),
     "docs/results/bench_diagnose_time.md": ("results/bench/diagnose_time.md", "python bench/diagnose_time.py"),
+    "docs/results/design_check.md": ("results/design_check/design_check.md",
+                                     "python scripts/design_check.py configs/span_drake_300m.toml"),
     "docs/results/bench_importer_tolerance.md": ("results/bench/importer_tolerance.md",
                                                  "python bench/importer_tolerance.py"),
 }

@@ -1,0 +1,158 @@
+"""The span design check: from a SPAN.toml and the damper FMU to a report an engineer can hand on.
+
+Steps: the aeolian band of the conductor (Strouhal × wind range / D); the damper's mean power over that band
+and a range of clamp amplitudes (DamperElement FMU, `energy_balance.damper_power_table`); steady amplitudes
+by the energy balance (CIGRE wind power with turbulence, the self-damping law, every damper at its own
+position); the Poffenberger–Swart stress at the clamp; the best positions for 1…max_dampers dampers
+(`placement`); fatigue of the recommended configuration (CIGRE safe border line, IEEE 150 µε, yearly
+damage over the Weibull climate). Writes design_check.md, design_check.json, damper_power.csv and figures.
+"""
+from __future__ import annotations
+
+import json
+import math
+import pathlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from pyfit.design import fatigue, placement
+from pyfit.design.energy_balance import Conductor, DamperPowerTable, damper_power_table
+from pyfit.io.span_config import SpanDesign
+from pyfit.report import plots
+
+
+@dataclass
+class DesignResult:
+    """What the check found: the bare span, the best configuration per damper count, the recommendation
+    (fewest dampers that pass; else the lowest use), the one-damper position sweep and the fatigue figures."""
+
+    design: SpanDesign
+    table: DamperPowerTable
+    bare: placement.Configuration
+    best: dict[int, placement.Configuration]
+    recommended: placement.Configuration
+    sweep: list[placement.Configuration]
+    fatigue: dict
+
+
+def energy_balance_span(design: SpanDesign) -> Conductor:
+    """The span as the energy balance sees it (diameter, mass, tension, length, self-damping)."""
+    c = design.conductor
+    return Conductor(c.diameter, c.mass_per_length, design.tension, design.length, design.zeta, design.self_damping)
+
+
+def band_frequencies(design: SpanDesign) -> np.ndarray:
+    """n_frequencies log-spaced over the conductor's aeolian band [Hz]."""
+    return np.geomspace(*design.climate.band(design.conductor.diameter), design.n_frequencies)
+
+
+def fatigue_figures(design: SpanDesign, config: placement.Configuration, frequencies) -> dict:
+    """Stress and strain maxima (EI_min and EI_max), use of both criteria, yearly cycles, damage and life."""
+    c = design.conductor
+    limit = fatigue.endurance_stress(c.aluminium_layers)
+    stress_max_ei = fatigue.bending_stress(config.amplitudes, frequencies, c, design.tension, c.ei_max)
+    strain = fatigue.strain_peak_to_peak(config.stress, c)
+    damage, cycles = fatigue.yearly_damage(frequencies, config.stress, c.diameter, design.climate, c.aluminium_layers)
+    ieee_use = float(np.max(strain) / fatigue.IEEE_STRAIN_PP)
+    return {"endurance_stress_pa": limit, "max_stress_pa": float(np.max(config.stress)),
+            "max_stress_ei_max_pa": float(np.max(stress_max_ei)), "cigre_use": config.use,
+            "max_strain_pp": float(np.max(strain)), "ieee_use": ieee_use,
+            "yearly_damage": damage, "yearly_cycles": cycles,
+            "life_years": math.inf if damage == 0 else 1.0 / damage,
+            "passes": bool(config.use <= 1.0 and ieee_use <= 1.0),
+            "margin": 1.0 - max(config.use, ieee_use)}
+
+
+def run_design_check(design: SpanDesign, damper_fmu, workers: int | None = None,
+                     progress: bool = True) -> DesignResult:
+    """The whole check (the damper table takes most of the time: n_frequencies × n_amplitudes FMU runs)."""
+    freqs = band_frequencies(design)
+    amps = np.geomspace(*design.amplitudes, design.n_amplitudes)
+    table = damper_power_table(damper_fmu, freqs, amps, design.damper_parameters, workers=workers, progress=progress)
+    span = energy_balance_span(design)
+    args = (span, design.conductor, table)
+    bare = placement.evaluate(*args, (), design.turbulence)
+    best = {n: placement.optimise(*args, n, design.x_range, design.step, design.turbulence, design.min_spacing)
+            for n in range(1, design.max_dampers + 1)}
+    passing = [cfg for n, cfg in sorted(best.items()) if cfg.use <= 1.0]
+    recommended = passing[0] if passing else min(best.values(), key=lambda cfg: cfg.use)
+    sweep = sorted(placement.grid_search(*args, 1, placement.position_grid(design.x_range, design.step),
+                                         design.turbulence), key=lambda cfg: cfg.positions)
+    return DesignResult(design, table, bare, best, recommended, sweep, fatigue_figures(design, recommended, freqs))
+
+
+def _unresolved(cfg: placement.Configuration, freqs) -> str:
+    return ", ".join(f"{f:.1f}" for f in freqs[~np.isfinite(cfg.stress)]) + " Hz"
+
+
+def _positions(cfg: placement.Configuration) -> str:
+    return ", ".join(f"{x:.2f}" for x in cfg.positions) + " m"
+
+
+def write_report(result: DesignResult, out_dir) -> pathlib.Path:
+    """design_check.md (+ .json, damper_power.csv and the figures) into out_dir; returns the md path."""
+    out = pathlib.Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    d, c, fat = result.design, result.design.conductor, result.fatigue
+    freqs = result.table.frequencies
+    result.table.save(out / "damper_power.csv")
+    law = f"{d.self_damping[0].label}, k = {d.self_damping[1]:.4g}" if d.self_damping else f"viscous ζ = {d.zeta:g}"
+    verdict = "PASSES" if fat["passes"] else "FAILS"
+    lines = [f"# Span design check: {c.name}, {d.length:g} m at {d.tension / 1e3:.1f} kN ({d.tension / c.rts:.0%} RTS)", "",
+             f"**The span {verdict} with {len(result.recommended.positions)} damper(s) at {_positions(result.recommended)} "
+             f"from the suspension clamp: fatigue margin {fat['margin']:.1%}** (1 − the larger of the CIGRE and IEEE "
+             "uses below).", "",
+             f"Conductor: D = {c.diameter * 1e3:.2f} mm, {c.mass_per_length:g} kg/m, RTS {c.rts / 1e3:.1f} kN, "
+             f"EI {c.ei_min:.1f}–{c.ei_max:.0f} N·m², outer wires {c.outer_wire_diameter * 1e3:.2f} mm, "
+             f"{c.aluminium_layers} aluminium layer(s). Self-damping: {law}. Wind: CIGRE power, turbulence "
+             f"{d.turbulence:g}; Weibull k = {d.climate.weibull_shape:g}, c = {d.climate.weibull_scale:g} m/s; "
+             f"aeolian {d.climate.speed_range[0]:g}–{d.climate.speed_range[1]:g} m/s, St "
+             f"{d.climate.strouhal[0]:g}–{d.climate.strouhal[1]:g}: band {freqs[0]:.1f}–{freqs[-1]:.1f} Hz.", "",
+             "| dampers | positions from the clamp | max σ_a [MPa] | CIGRE use (σ_a / σ_endurance) |",
+             "|---|---|---|---|",
+             f"| 0 | — | {np.max(result.bare.stress) / 1e6:.2f} | {result.bare.use:.2f} |"]
+    for n, cfg in sorted(result.best.items()):
+        if math.isfinite(cfg.use):
+            lines.append(f"| {n} | {_positions(cfg)} | {np.max(cfg.stress) / 1e6:.2f} | {cfg.use:.3f} |")
+        else:
+            lines.append(f"| {n} | unresolved at every position: at {_unresolved(cfg, freqs)} the balance needs "
+                         "clamp amplitudes beyond those the damper FMU ran at | — | — |")
+    lines += ["", f"Recommended (fewest dampers that pass, else the lowest use): {_positions(result.recommended)}.", "",
+              "| fatigue of the recommended configuration | value |", "|---|---|",
+              f"| endurance stress, CIGRE safe border line at 5·10⁸ cycles | {fat['endurance_stress_pa'] / 1e6:.2f} MPa |",
+              f"| max bending stress σ_a at the clamp (EI_min; EI_max) | {fat['max_stress_pa'] / 1e6:.2f} MPa; "
+              f"{fat['max_stress_ei_max_pa'] / 1e6:.2f} MPa |",
+              f"| CIGRE use | {fat['cigre_use']:.3f} |",
+              f"| max bending strain at 89 mm, peak to peak (IEEE limit 150 µε) | {fat['max_strain_pp'] * 1e6:.1f} µε |",
+              f"| IEEE use | {fat['ieee_use']:.3f} |",
+              f"| cycles per year (aeolian fraction {d.climate.aeolian_fraction:g}) | {fat['yearly_cycles']:.3g} |",
+              f"| Miner damage per year (safe border line as S-N curve) | {fat['yearly_damage']:.3g} |",
+              f"| life at that rate | {fat['life_years']:.3g} years |", "",
+              "![antinode amplitude over the band, without and with the best configurations](design_amplitude.png)",
+              "", "![stress at the clamp and the endurance line](design_stress.png)", "",
+              "![worst-case use of one damper against its position](design_positions.png)"]
+    md = out / "design_check.md"
+    md.write_text("\n".join(lines) + "\n")
+    (out / "design_check.json").write_text(json.dumps({
+        "conductor": c.name, "span_m": d.length, "tension_n": d.tension, "band_hz": [freqs[0], freqs[-1]],
+        "bare_use": result.bare.use,
+        "best": {str(n): {"positions_m": list(cfg.positions), "use": cfg.use} for n, cfg in result.best.items()},
+        "recommended_positions_m": list(result.recommended.positions), **fat}, indent=2, default=float))
+    styles = ["o-", "s-", "^-", "d-"]
+    configs = [("no damper", result.bare, "k-")] + [
+        (f"{n} at {_positions(cfg)}", cfg, styles[n - 1]) for n, cfg in sorted(result.best.items())]
+    plots.semilogy_curves(out / "design_amplitude.png", [(lab, freqs, cfg.amplitudes * 1e3, st) for lab, cfg, st in configs],
+                          "frequency [Hz]", "steady antinode amplitude Y [mm]", "Energy balance over the aeolian band")
+    limit = fat["endurance_stress_pa"] / 1e6
+    plots.semilogy_curves(out / "design_stress.png", [(lab, freqs, cfg.stress / 1e6, st) for lab, cfg, st in configs]
+                          + [("endurance (CIGRE SBL, 5e8 cycles)", freqs[[0, -1]], [limit, limit], "r--")],
+                          "frequency [Hz]", "bending stress σ_a at the clamp [MPa]",
+                          "Poffenberger–Swart stress (EI_min); Y_b at 89 mm")
+    plots.semilogy_curves(out / "design_positions.png",
+                          [("one damper (unresolved positions not shown)", [cfg.positions[0] for cfg in result.sweep],
+                            [cfg.use if math.isfinite(cfg.use) else np.nan for cfg in result.sweep], "o-"),
+                           ("limit", list(d.x_range), [1.0, 1.0], "r--")],
+                          "damper position from the clamp [m]", "worst-case CIGRE use over the band [-]",
+                          "Position sweep, one damper", log=False)
+    return md

@@ -1,0 +1,185 @@
+"""Span design check: conductor bending stiffness, Poffenberger–Swart against a direct solution of the beam
+with tension, safe border line, energy balance with several dampers, placement against a brute-force grid,
+the SPAN.toml reader and the design_check command."""
+import math
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_bvp
+
+from pyfit.design import conductor as cd
+from pyfit.design import energy_balance as eb
+from pyfit.design import fatigue, placement
+from pyfit.io.schema import ConfigError
+from pyfit.io.span_config import load_span_design
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+DRAKE = cd.DRAKE
+TENSION = 0.2 * DRAKE.rts
+
+
+def test_drake_stranding_gives_its_catalogue_diameter_and_stiffness_bounds(measured):
+    """Outer diameter 28.1 mm (ASTM B232: 1.108 in = 28.14 mm); EI bounds by summing each wire at its actual
+    angular position (parallel-axis theorem wire by wire) against the layer formula n·A·r²/2."""
+    measured("Drake outer diameter from its stranding vs the catalogue 28.14 mm: |Δ| [m]",
+             abs(DRAKE.diameter - 28.14e-3), 0.05e-3)
+    ei_min = ei_max = 0.0
+    radius = 0.0
+    for k, layer in enumerate((cd.Layer(1, 3.45e-3, cd.STEEL_E, "steel"), cd.Layer(6, 3.45e-3, cd.STEEL_E, "steel"),
+                               cd.Layer(10, 4.44e-3, cd.ALUMINIUM_E, "aluminium"),
+                               cd.Layer(16, 4.44e-3, cd.ALUMINIUM_E, "aluminium"))):
+        d = layer.wire_diameter
+        r = 0.0 if k == 0 else radius + d / 2
+        radius = d / 2 if k == 0 else radius + d
+        angles = 2 * np.pi * np.arange(layer.n) / layer.n + 0.3 * k  # any orientation of the ring
+        i_own = np.pi * d ** 4 / 64
+        ei_min += layer.n * layer.youngs_modulus * i_own
+        ei_max += layer.youngs_modulus * np.sum(i_own + np.pi * d ** 2 / 4 * (r * np.sin(angles)) ** 2)
+    assert DRAKE.ei_min == pytest.approx(ei_min, rel=1e-12)
+    assert DRAKE.ei_max == pytest.approx(ei_max, rel=1e-12)
+    assert DRAKE.aluminium_layers == 2 and 30 < DRAKE.ei_max / DRAKE.ei_min < 40
+
+
+@pytest.mark.parametrize("ei", [DRAKE.ei_min, DRAKE.ei_max])
+def test_poffenberger_swart_against_the_beam_with_tension_solved_directly(ei, measured):
+    """EI y'''' − T y'' = 0 on [0, 40/p], clamped at 0, leaving with the standing wave's slope θ and no
+    curvature, solved by scipy's collocation BVP solver: Y_b = 2 y(89 mm) and σ_a = E_a d_a y''(0) / 2."""
+    Y, f = 0.3 * DRAKE.diameter, 20.0
+    theta = float(fatigue.clamp_slope(Y, f, TENSION, DRAKE.mass_per_length))
+    p = math.sqrt(TENSION / ei)
+    length = 40 / p
+
+    def rhs(x, y):
+        return np.vstack([y[1], y[2], y[3], (TENSION / ei) * y[2]])
+
+    def bc(ya, yb):
+        return np.array([ya[0], ya[1], yb[1] - theta, yb[2]])
+
+    x = np.linspace(0, length, 4000)
+    guess = np.vstack([theta * (x - (1 - np.exp(-p * x)) / p), theta * (1 - np.exp(-p * x)),
+                       theta * p * np.exp(-p * x), -theta * p ** 2 * np.exp(-p * x)])
+    sol = solve_bvp(rhs, bc, x, guess, tol=1e-10, max_nodes=200000)
+    assert sol.success
+    yb_direct = 2 * sol.sol(fatigue.X_B)[0]
+    stress_direct = DRAKE.outer_youngs_modulus * DRAKE.outer_wire_diameter * sol.sol(0.0)[2] / 2
+    yb = float(fatigue.bending_amplitude(Y, f, TENSION, DRAKE.mass_per_length, ei))
+    stress = float(fatigue.bending_stress(Y, f, DRAKE, TENSION, ei))
+    measured(f"Poffenberger–Swart Y_b at 89 mm (EI = {ei:.1f} N·m²) vs the beam with tension solved directly: "
+             "relative error", abs(yb / yb_direct - 1), 1e-6)
+    measured(f"Poffenberger–Swart stress K·Y_b (EI = {ei:.1f} N·m²) vs E_a d_a y''(0)/2 of the direct solution: "
+             "relative error", abs(stress / stress_direct - 1), 1e-6)
+
+
+def test_safe_border_line_and_its_inverse():
+    """The published CIGRE coefficients (EPRI Orange Book §3.3) and the inverse on both branches."""
+    assert fatigue.safe_border_line(1e6, 2) == pytest.approx(450e6 * 1e6 ** -0.2, rel=1e-12)
+    assert fatigue.safe_border_line(1e8, 2) == pytest.approx(263e6 * 1e8 ** -0.17, rel=1e-12)
+    assert fatigue.safe_border_line(1e7, 1) == pytest.approx(730e6 * 1e7 ** -0.2, rel=1e-12)
+    assert fatigue.endurance_stress(2) / 1e6 == pytest.approx(263 * 5e8 ** -0.17, rel=1e-12)  # 8.73 MPa
+    for n in (1e5, 3e6, 1e8, 5e9):
+        for layers in (1, 2):
+            assert fatigue.cycles_to_failure(fatigue.safe_border_line(n, layers), layers) == pytest.approx(n, rel=1e-9)
+    assert fatigue.cycles_to_failure(0.0, 2) == math.inf
+
+
+def test_yearly_cycles_follow_the_weibull_climate():
+    """A flat stress σ below every knee over the band: cycles per year = ∫ St·V/D dP(V) over the range
+    (worst Strouhal: the upper one), damage = cycles / N(σ)."""
+    climate = fatigue.WindClimate(2.0, 4.0, (1.0, 7.0), (0.185, 0.2), 0.5)
+    f = np.geomspace(*climate.band(DRAKE.diameter), 50)
+    sigma = 5e6
+    damage, cycles = fatigue.yearly_damage(f, np.full_like(f, sigma), DRAKE.diameter, climate, 2, bins=4000)
+    v = np.linspace(1.0, 7.0, 200001)
+    pdf = (2.0 / 4.0) * (v / 4.0) * np.exp(-(v / 4.0) ** 2)
+    expected = 0.5 * fatigue.SECONDS_PER_YEAR * np.trapezoid(0.2 * v / DRAKE.diameter * pdf, v)
+    assert cycles == pytest.approx(expected, rel=1e-5)
+    assert damage == pytest.approx(cycles / fatigue.cycles_to_failure(sigma, 2), rel=1e-12)
+
+
+def test_two_dampers_add_their_power_with_their_phase_on_the_wave():
+    """Two dashpots (power ½ c ω² a²) at x1, x2 give the amplitude of one dashpot at x1 with
+    c·(sin²kx1 + sin²kx2)/sin²kx1: each is driven by the standing wave at its own position."""
+    span = eb.Conductor(DRAKE.diameter, DRAKE.mass_per_length, TENSION, 300.0, 0.0,
+                        (cd.SELF_DAMPING_LAWS["noiseux1991"], cd.self_damping_constant(DRAKE)))
+    f, c, x1, x2 = 25.0, 40.0, 0.6, 1.7
+    w, k = 2 * np.pi * f, 2 * np.pi / float(span.wavelength(f))
+    dash = lambda c_: (lambda a: 0.5 * c_ * w ** 2 * np.asarray(a) ** 2)  # noqa: E731
+    two = eb.steady_amplitude(f, span, [(dash(c), x1), (dash(c), x2)])
+    one = eb.steady_amplitude(f, span, [(dash(c * (np.sin(k * x1) ** 2 + np.sin(k * x2) ** 2) / np.sin(k * x1) ** 2), x1)])
+    assert two == pytest.approx(one, rel=1e-9)
+    assert two < eb.steady_amplitude(f, span, [(dash(c), x1)]) < eb.steady_amplitude(f, span)
+
+
+def test_power_law_self_damping_exponents():
+    """P/L = k Y^l f^m / T^n with the tabulated Noiseux (1991) exponents l = 2.44, m = 5.63, n = 2.76."""
+    law = cd.SELF_DAMPING_LAWS["noiseux1991"]
+    assert (law.l, law.m, law.n) == (2.44, 5.63, 2.76)
+    p = lambda f, Y, T: cd.self_damping_power_per_length(law, 1.7, f, Y, T)  # noqa: E731
+    assert p(20, 2e-3, 3e4) / p(20, 1e-3, 3e4) == pytest.approx(2 ** 2.44, rel=1e-12)
+    assert p(40, 1e-3, 3e4) / p(20, 1e-3, 3e4) == pytest.approx(2 ** 5.63, rel=1e-12)
+    assert p(20, 1e-3, 6e4) / p(20, 1e-3, 3e4) == pytest.approx(2 ** -2.76, rel=1e-12)
+    assert p(20, 1e-3, 3e4) == pytest.approx(1.7 * 1e-3 ** 2.44 * 20 ** 5.63 / 30 ** 2.76, rel=1e-12)
+
+
+@pytest.fixture(scope="module")
+def drake_table(fmu_dir):
+    """The design damper's power over a coarse band grid (7 frequencies × 6 clamp amplitudes)."""
+    freqs = np.geomspace(6.6, 49.8, 7)
+    return eb.damper_power_table(fmu_dir / "DamperElement.fmu", freqs, np.geomspace(1e-5, 1e-2, 6), progress=False)
+
+
+def test_placement_is_at_least_as_good_as_a_brute_force_grid(drake_table, measured):
+    """300 m ACSR Drake at 20 % RTS with the design damper: the optimiser's best 1 and 2 dampers in 0.5–3 m
+    against every configuration of 1–2 dampers on a 0.5 m grid (and 3 dampers checked on the same grid)."""
+    span = eb.Conductor(DRAKE.diameter, DRAKE.mass_per_length, TENSION, 300.0, 0.0,
+                        (cd.SELF_DAMPING_LAWS["noiseux1991"], cd.self_damping_constant(DRAKE)))
+    coarse = placement.position_grid((0.5, 3.0), 0.5)
+    for n in (1, 2):
+        best = placement.optimise(span, DRAKE, drake_table, n, (0.5, 3.0), step=0.25)
+        brute = placement.grid_search(span, DRAKE, drake_table, n, coarse)
+        assert len(brute) == math.comb(6, n)
+        measured(f"placement of {n} damper(s): optimiser's worst-case fatigue use minus the best of a 0.5 m "
+                 "brute-force grid (≤ 0)", best.use - brute[0].use, 0.0)
+    bare = placement.evaluate(span, DRAKE, drake_table, ())
+    assert bare.use > placement.grid_search(span, DRAKE, drake_table, 1, coarse)[0].use
+
+
+def test_span_config_errors_name_the_key(tmp_path):
+    cases = {
+        "[conductor]\ntype = 'dove'\n[span]\nlength = 300\ntension_rts = 0.2\n": "[conductor.type] unknown conductor",
+        "[conductor]\ntype = 'drake'\n[span]\nlength = 300\n": "give exactly one of tension",
+        "[conductor]\ntype = 'drake'\n[span]\nlength = 300\ntension = 2e4\n[self_damping]\nlaw = 'x'\n":
+            "[self_damping.law] unknown law",
+        "[conductor]\ntype = 'drake'\n[span]\nlength = -3\ntension = 2e4\n": "[span.length] must be > 0",
+        "[conductor]\ntype = 'drake'\n[span]\nlength = 300\ntension = 2e4\n[wind]\nstrouhal = [0.2, 0.1]\n":
+            "[wind.strouhal] inverted",
+    }
+    for text, expected in cases.items():
+        path = tmp_path / "span.toml"
+        path.write_text(text)
+        with pytest.raises(ConfigError, match=expected.replace("[", r"\[").replace("]", r"\]")):
+            load_span_design(path)
+    design = load_span_design(ROOT / "configs" / "span_drake_300m.toml")
+    assert design.tension == pytest.approx(0.2 * DRAKE.rts) and design.self_damping[0].l == 2.44
+
+
+def test_design_check_command_writes_the_report(fmu_dir, tmp_path):
+    span = tmp_path / "span.toml"
+    span.write_text((ROOT / "configs" / "span_drake_300m.toml").read_text()
+                    .replace("n_amplitudes = 10", "n_amplitudes = 4").replace("n_frequencies = 20", "n_frequencies = 3")
+                    .replace("max_dampers = 2", "max_dampers = 1").replace("step = 0.25", "step = 0.5"))
+    run = subprocess.run([sys.executable, str(ROOT / "scripts" / "design_check.py"), str(span), "--fmus", str(fmu_dir),
+                          "--out", str(tmp_path / "out"), "--workers", "1"], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    md = (tmp_path / "out" / "design_check.md").read_text()
+    assert "Span design check: ACSR Drake" in md and ("PASSES" in md or "FAILS" in md)
+    for name in ("design_amplitude.png", "design_stress.png", "design_positions.png", "design_check.json"):
+        assert (tmp_path / "out" / name).is_file()
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[span]\nlength = 1\n")
+    run = subprocess.run([sys.executable, str(ROOT / "scripts" / "design_check.py"), str(bad)], capture_output=True,
+                         text=True, timeout=60)
+    assert run.returncode == 1 and "[conductor] missing section" in run.stderr
