@@ -1,5 +1,9 @@
 """The build: every example becomes a valid FMI 2.0 FMU (ME + CS) whose two interfaces agree."""
+import os
+import pathlib
 import shutil
+import subprocess
+import sys
 import zipfile
 
 import numpy as np
@@ -9,6 +13,8 @@ from fmpy.validation import validate_fmu
 
 from pyfit.build import EXAMPLES, LIBRARY, ModelicaError, build_all
 from pyfit.runtime.fmu import ParameterError
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 # name -> (outputs compared, parameters for a short nonlinear run, stop time [s])
 RUNS = {
@@ -95,3 +101,18 @@ def test_out_of_range_parameter_is_rejected_with_its_range(runner):
         runner("SDOFBoucWen").simulate(0.1, 1e-3, ["y"], {"m": -1.0})
     with pytest.raises(ParameterError, match=r"'a_bw' = 1.5 outside \[0.0, 1.0\]"):
         runner("StockbridgeDamper").simulate(0.1, 1e-3, ["x1"], {"a_bw": 1.5})
+
+
+def test_the_build_is_the_same_in_every_process():
+    """A process with another hash seed (Python's set order) reduces the damper to the same equations as this
+    one: the same GUID (a hash of the interface and the equations)."""
+    from pyfit.build import codegen, frontend, reduce
+
+    code = ("from pyfit.build import frontend, reduce, codegen, LIBRARY, EXAMPLES; "
+            "m = reduce.reduce_model(frontend.load(LIBRARY, EXAMPLES['DamperElement'])); "
+            "print(codegen.guid_for(m, codegen.layout(m)))")
+    seed = "2" if os.environ.get("PYTHONHASHSEED") == "1" else "1"
+    other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT,
+                           env={**os.environ, "PYTHONHASHSEED": seed}).stdout.strip()
+    m = reduce.reduce_model(frontend.load(LIBRARY, EXAMPLES["DamperElement"]))
+    assert other == codegen.guid_for(m, codegen.layout(m))

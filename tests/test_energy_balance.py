@@ -42,20 +42,22 @@ def test_amplitude_with_a_viscous_damper_is_the_root_of_the_balance_polynomial()
     quad = (0.5 * c.zeta * c.mass_per_length * w ** 3 * L + 0.5 * c_d * w ** 2 * s ** 2) * D ** 2 / (f ** 3 * D ** 4 * L)
     a3, a2, a1, a0 = eb.CIGRE_FNC
     eta = _first_positive_root([a3, a2 - quad, a1, a0])
-    Y = eb.steady_amplitude(f, c, [(lambda a: 0.5 * c_d * w ** 2 * a ** 2, x_d)])
+    Y = eb.steady_amplitude(f, c, [(lambda a: np.full(np.shape(a), c_d + 0j), x_d)], reaction=False)
     assert Y / D == pytest.approx(eta, rel=1e-8)
     assert Y < 0.5 * eb.steady_amplitude(f, c)  # the dashpot takes most of the wind's power
 
 
-def test_damper_table_interpolates_power_law_exactly():
+def test_damper_table_interpolates_impedance_linearly_in_log_amplitude():
     amps = np.geomspace(1e-5, 1e-2, 7)
-    table = eb.DamperPowerTable(np.array([10.0]), amps, (3.0 * amps ** 2.5)[None, :])
+    z = (3.0 + 2.0 * np.log(amps)) + 1j * (1.0 - 0.5 * np.log(amps))  # linear in log a: reproduced exactly
+    table = eb.DamperPowerTable(np.array([10.0]), amps, np.zeros((1, 7)), np.zeros((1, 7)), z[None, :])
     for a in (2e-5, 3.3e-4, 9e-3):
-        assert table.at(0, a) == pytest.approx(3.0 * a ** 2.5, rel=1e-12)
-    assert table.at(0, 1e-6) == pytest.approx(3.0 * 1e-5 ** 2.5 * 0.01, rel=1e-12)  # ∝ a² below the table
-    assert math.isnan(table.at(0, 2e-2))
-    table.power[0, 4] = np.nan  # a failed run ends the valid range
-    assert table.valid_amplitude(0) == amps[3] and math.isnan(table.at(0, amps[4] * 1.1))
+        assert table.impedance_at(0, a) == pytest.approx((3.0 + 2.0 * np.log(a)) + 1j * (1.0 - 0.5 * np.log(a)),
+                                                         rel=1e-12)
+    assert table.impedance_at(0, 1e-6) == z[0]  # the linear range below the table
+    assert np.isnan(table.impedance_at(0, 2e-2))  # above it: unknown
+    table.impedance[0, 4] = np.nan  # a failed run: unknown next to it
+    assert np.isnan(table.impedance_at(0, amps[4] * 1.1)) and np.isnan(table.impedance_at(0, amps[3] * 1.1))
 
 
 def test_damper_fmu_power_matches_independent_harmonic_solution(fmu_dir, measured):

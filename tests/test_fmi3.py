@@ -14,7 +14,7 @@ from fmpy.validation import validate_fmu
 from pyfit.build import EXAMPLES, fmi3_path
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-STOP, STEP = 0.5, 1e-3  # s
+STOP, STEP = 0.2, 1e-3  # s
 
 
 @pytest.mark.parametrize("name", list(EXAMPLES))

@@ -116,7 +116,7 @@ class _Reducer:
     def _d_dt(self, g: ca.SX) -> ca.SX:
         """Total time derivative of an expression of states, inputs, parameters and time."""
         out = ca.jacobian(g, self.t)
-        for n in self._names_in(g):
+        for n in sorted(self._names_in(g)):  # sorted: the same expression (and GUID) in every process
             if n == "time":
                 continue
             v = self.by_name.get(n)

@@ -18,6 +18,8 @@ import numpy as np
 
 from pyfit.design import fatigue, placement
 from pyfit.design.energy_balance import Conductor, DamperPowerTable, damper_power_table
+from pyfit.io.impedance import read_impedance
+from pyfit.io.schema import ConfigError
 from pyfit.io.span_config import SpanDesign
 from pyfit.report import plots
 
@@ -47,6 +49,23 @@ def band_frequencies(design: SpanDesign) -> np.ndarray:
     return np.geomspace(*design.climate.band(design.conductor.diameter), design.n_frequencies)
 
 
+def damper_table(design: SpanDesign, damper_fmu, workers: int | None = None, progress: bool = True) -> DamperPowerTable:
+    """The damper over the band: its measured impedance test (the frequencies inside the band) if the design
+    names one, else the damper FMU simulated at n_frequencies × n_amplitudes."""
+    if design.impedance_file is None:
+        return damper_power_table(damper_fmu, band_frequencies(design),
+                                  np.geomspace(*design.amplitudes, design.n_amplitudes), design.damper_parameters,
+                                  workers=workers, progress=progress)
+    test = DamperPowerTable.from_test(read_impedance(design.impedance_file))
+    lo, hi = design.climate.band(design.conductor.diameter)
+    inside = (test.frequencies >= lo) & (test.frequencies <= hi)
+    if np.sum(inside) < 2:
+        raise ConfigError(f"{design.impedance_file}: fewer than two test frequencies inside the aeolian band "
+                          f"{lo:.1f}–{hi:.1f} Hz; allowed: a test that covers the band")
+    return DamperPowerTable(test.frequencies[inside], test.amplitudes[inside], test.power[inside],
+                            test.drift[inside], test.impedance[inside])
+
+
 def fatigue_figures(design: SpanDesign, config: placement.Configuration, frequencies) -> dict:
     """Stress and strain maxima (EI_min and EI_max), use of both criteria, yearly cycles, damage and life."""
     c = design.conductor
@@ -67,9 +86,8 @@ def fatigue_figures(design: SpanDesign, config: placement.Configuration, frequen
 def run_design_check(design: SpanDesign, damper_fmu, workers: int | None = None,
                      progress: bool = True) -> DesignResult:
     """The whole check (the damper table takes most of the time: n_frequencies × n_amplitudes FMU runs)."""
-    freqs = band_frequencies(design)
-    amps = np.geomspace(*design.amplitudes, design.n_amplitudes)
-    table = damper_power_table(damper_fmu, freqs, amps, design.damper_parameters, workers=workers, progress=progress)
+    table = damper_table(design, damper_fmu, workers, progress)
+    freqs = table.frequencies
     span = energy_balance_span(design)
     args = (span, design.conductor, table)
     bare = placement.evaluate(*args, (), design.turbulence)
@@ -99,13 +117,16 @@ def write_report(result: DesignResult, out_dir) -> pathlib.Path:
     result.table.save(out / "damper_power.csv")
     law = f"{d.self_damping[0].label}, k = {d.self_damping[1]:.4g}" if d.self_damping else f"viscous ζ = {d.zeta:g}"
     verdict = "PASSES" if fat["passes"] else "FAILS"
+    damper = (f"measured impedance `{d.impedance_file.name}`" if d.impedance_file else "DamperElement FMU" + (
+        " with " + ", ".join(f"{k} = {v:g}" for k, v in sorted(d.damper_parameters.items()))
+        if d.damper_parameters else " (design §1.3 defaults)"))
     lines = [f"# Span design check: {c.name}, {d.length:g} m at {d.tension / 1e3:.1f} kN ({d.tension / c.rts:.0%} RTS)", "",
              f"**The span {verdict} with {len(result.recommended.positions)} damper(s) at {_positions(result.recommended)} "
-             f"from the suspension clamp: fatigue margin {fat['margin']:.1%}** (1 − the larger of the CIGRE and IEEE "
-             "uses below).", "",
+             f"from the suspension clamp: the worst fatigue use is {1 - fat['margin']:.2f} of the limit, a margin of "
+             f"{fat['margin']:.0%}** (use: the larger of the CIGRE and IEEE uses below).", "",
              f"Conductor: D = {c.diameter * 1e3:.2f} mm, {c.mass_per_length:g} kg/m, RTS {c.rts / 1e3:.1f} kN, "
              f"EI {c.ei_min:.1f}–{c.ei_max:.0f} N·m², outer wires {c.outer_wire_diameter * 1e3:.2f} mm, "
-             f"{c.aluminium_layers} aluminium layer(s). Self-damping: {law}. Wind: CIGRE power, turbulence "
+             f"{c.aluminium_layers} aluminium layer(s). Damper: {damper}. Self-damping: {law}. Wind: CIGRE power, turbulence "
              f"{d.turbulence:g}; Weibull k = {d.climate.weibull_shape:g}, c = {d.climate.weibull_scale:g} m/s; "
              f"aeolian {d.climate.speed_range[0]:g}–{d.climate.speed_range[1]:g} m/s, St "
              f"{d.climate.strouhal[0]:g}–{d.climate.strouhal[1]:g}: band {freqs[0]:.1f}–{freqs[-1]:.1f} Hz.", "",

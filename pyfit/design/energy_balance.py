@@ -3,7 +3,7 @@
 In steady aeolian vibration at frequency f with antinode amplitude Y (zero to peak), the power the wind
 puts into the span equals the power the conductor's self-damping and the damper dissipate:
 
-    P_wind(f, Y) = P_self(f, Y) + P_damper(f, Y · |sin(2π x_d / λ)|),   λ = sqrt(T / m_l) / f.
+    P_wind(f, Y) = P_self(f, Y) + Σ P_damper,i,   P_damper = ½ Re(Z) ω² a²   at each damper's clamp amplitude a.
 
 - Wind power input, per unit length: f³ D⁴ fnc(Y/D) with the CIGRE reduced-power polynomial
   fnc(η) = (-99.73 η³ + 101.62 η² + 0.1627 η + 0.2256) / sqrt(1 + (I_v / 0.09)²)  [W/(m·Hz³·m⁴)],
@@ -13,13 +13,15 @@ puts into the span equals the power the conductor's self-damping and the damper 
 - Self-damping: a published power law P/L = k Y^l f^m / T^n (`pyfit.design.conductor`), or the span's
   viscous modal damping ζ (the same law the ConductorSpan FMU uses): a standing wave of antinode amplitude Y
   stores ¼ m_l ω² Y² per metre, so P_self = ½ ζ m_l ω³ Y² · L.
-- Dampers (any number): the mean power the damper FMU takes when its clamp follows the undisturbed standing
-  wave at its position (F_clamp · v_clamp averaged over whole periods of the steady state), tabulated over frequency and
-  clamp amplitude and interpolated log-log in amplitude.
+- Dampers (any number): the damper FMU's clamp impedance Z = F̂_clamp / v̂_clamp (first harmonics over
+  whole periods of the steady state under a clamp sine) and mean power F_clamp · v_clamp, tabulated over
+  frequency and clamp amplitude (the IEC 61897 characteristic). Each damper's clamp amplitude comes from the
+  string solved with the dampers' forces on it (`clamp_amplitudes`; the basic method, reaction=False, lets
+  each damper follow the undisturbed wave, a = Y·|sin(2π x_d / λ)|, λ = sqrt(T / m_l) / f, which
+  overestimates a strong damper's effect: see scripts/verify_balance.py).
 
-The steady amplitude is the first root of P_wind - P_self - P_damper going up from Y = 0 (vibration builds
-up from rest until the first stable balance). The damper's reaction on the wave is neglected, as in the
-basic EBM.
+The steady amplitude is the first root of P_wind - P_self - Σ P_damper going up from Y = 0 (vibration builds
+up from rest until the first stable balance).
 """
 from __future__ import annotations
 
@@ -32,6 +34,7 @@ from scipy.optimize import brentq
 
 from pyfit.design.conductor import PowerLaw, self_damping_power_per_length
 from pyfit.design.span import span_properties
+from pyfit.io.impedance import write_impedance
 from pyfit.report import plots
 from pyfit.runtime.batch import RunSpec, run_batch
 
@@ -85,92 +88,147 @@ def self_damping_power(f, Y, conductor: Conductor):
 
 @dataclass
 class DamperPowerTable:
-    """Mean power [W] into the damper, power[i, j] at frequencies[i] [Hz] and clamp amplitudes[j] [m]
-    (NaN where the simulation failed); drift[i, j]: relative change between the two halves of the
-    averaging window (how steady the state was)."""
+    """The damper at frequencies[i] [Hz] and clamp amplitudes[j] [m] (or amplitudes[i, j]: a measured
+    table's own amplitudes at each frequency): mean power [W] and clamp impedance [N·s/m], NaN where the
+    simulation failed; drift[i, j]: relative change of the power between the two halves of the averaging
+    window (how steady the state was)."""
 
     frequencies: np.ndarray
     amplitudes: np.ndarray
     power: np.ndarray
     drift: np.ndarray = field(default=None)
+    impedance: np.ndarray = field(default=None)  # complex Z = F̂_clamp / v̂_clamp [N·s/m], first harmonics
 
-    def at(self, i: int, a):
-        """Power [W] at frequencies[i] and clamp amplitude(s) a [m]: log-log interpolation; ∝ a² below the
-        table (the linear range); NaN above it or next to a failed run. Scalar in, float out."""
+    @classmethod
+    def from_test(cls, test) -> "DamperPowerTable":
+        """The table of a measured impedance test (`pyfit.io.impedance.ImpedanceTest`): power ½ Re Z ω² a²."""
+        power = 0.5 * test.impedance.real * (2 * np.pi * test.frequencies[:, None]) ** 2 * test.amplitudes ** 2
+        return cls(test.frequencies, test.amplitudes, power, np.zeros(power.shape), test.impedance)
+
+    def amplitudes_at(self, i: int) -> np.ndarray:
+        """Clamp amplitudes [m] of the table's row at frequencies[i]."""
+        return self.amplitudes if self.amplitudes.ndim == 1 else self.amplitudes[i]
+
+    def impedance_at(self, i: int, a):
+        """Impedance [N·s/m] at frequencies[i] and clamp amplitude(s) a [m]: real and imaginary parts linear in
+        log a; the smallest amplitude's below the table (the linear range); NaN above it or next to a failed
+        run."""
         a = np.asarray(a, float)
-        amps, p = self.amplitudes, self.power[i]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            logp = np.where(p > 0, np.log(np.where(p > 0, p, 1.0)), np.nan)
-            j = np.clip(np.searchsorted(amps, a), 1, len(amps) - 1)
-            s = np.log(np.maximum(a, 1e-300) / amps[j - 1]) / np.log(amps[j] / amps[j - 1])
-            out = np.exp((1 - s) * logp[j - 1] + s * logp[j])
-            out = np.where(a <= amps[0], p[0] * (a / amps[0]) ** 2, out)
-        out = np.where(a > amps[-1], np.nan, np.where(a <= 0, 0.0, out))
-        return float(out) if out.ndim == 0 else out
+        amps, z = self.amplitudes_at(i), self.impedance[i]
+        j = np.clip(np.searchsorted(amps, a), 1, len(amps) - 1)
+        s = np.log(np.maximum(a, amps[0]) / amps[j - 1]) / np.log(amps[j] / amps[j - 1])
+        out = np.where(a <= amps[0], z[0], (1 - s) * z[j - 1] + s * z[j])
+        return np.where(a > amps[-1], np.nan + 0j, out)
 
     def save(self, path) -> None:
-        """CSV: one row per frequency [Hz], one column per clamp amplitude [m], mean power [W]."""
-        header = "frequency_hz," + ",".join(f"P_at_{a:.4g}_m" for a in self.amplitudes)
-        np.savetxt(path, np.column_stack([self.frequencies, self.power]), delimiter=",", header=header,
-                   comments="", fmt="%.6g")
-
-    def valid_amplitude(self, i: int) -> float:
-        """Largest clamp amplitude [m] up to which every run at frequencies[i] succeeded."""
-        ok = np.isfinite(self.power[i]) & (self.power[i] > 0)
-        bad = np.flatnonzero(~ok)
-        return float(self.amplitudes[-1] if bad.size == 0 else (self.amplitudes[bad[0] - 1] if bad[0] else 0.0))
+        """CSV: one row per frequency [Hz], one column per clamp amplitude [m], mean power [W]; and, beside it,
+        <stem>_impedance.csv + .toml, the IEC 61897 impedance test file that `pyfit.io.impedance` reads."""
+        path = pathlib.Path(path)
+        if self.amplitudes.ndim == 1:
+            header = "frequency_hz," + ",".join(f"P_at_{a:.4g}_m" for a in self.amplitudes)
+            np.savetxt(path, np.column_stack([self.frequencies, self.power]), delimiter=",", header=header,
+                       comments="", fmt="%.6g")
+        if self.impedance is not None:
+            amps = np.array([self.amplitudes_at(i) for i in range(len(self.frequencies))])
+            write_impedance(path.with_name(path.stem + "_impedance.csv"), self.frequencies, amps, self.impedance,
+                            "damper FMU: clamp sine, first harmonics over whole periods of the steady state")
 
 
 def damper_power_table(fmu, frequencies, amplitudes, params: dict | None = None, settle: float = 6.0,
                        average: float = 2.0, ramp: float = 1.5, workers: int | None = None,
                        progress: bool = True) -> DamperPowerTable:
     """Simulate the damper FMU (DamperElement) under its built-in clamp sine at every frequency [Hz] and
-    clamp amplitude [m]: smooth ramp-in over the first `ramp` s, steady state after `settle` s (the
-    default damper's slowest mode, 10 Hz at ζ ≈ 2.2 %, decays to 2e-4 in 6 s), then the mean of
-    F_clamp · v_clamp over the whole periods of the next `average` s."""
+    clamp amplitude [m] (one list for all frequencies, or one row per frequency): smooth ramp-in over the
+    first `ramp` s, steady state after `settle` s (the default damper's slowest mode, 10 Hz at ζ ≈ 2.2 %,
+    decays to 2e-4 in 6 s), then the mean of F_clamp · v_clamp and the first harmonics of F_clamp and
+    v_clamp over the whole periods of the next `average` s."""
     freqs, amps = np.asarray(frequencies, float), np.asarray(amplitudes, float)
+    rows = amps if amps.ndim == 2 else np.repeat(amps[None, :], len(freqs), axis=0)  # amplitudes per frequency
     specs, windows = [], []
-    for f in freqs:
+    for f, row in zip(freqs, rows):
         n_avg = max(2, int(round(average * f)))  # whole periods averaged
         periods = int(math.ceil(settle * f)) + n_avg
         per = 40  # samples per period: the mean over whole periods is exact for harmonics below 20
         windows.append((n_avg * per, per))
-        for a in amps:
+        for a in row:
             specs.append(RunSpec(str(fmu), periods / f, 1.0 / (per * f), ("F_clamp", "v_clamp"),
                                  {**(params or {}), "exc_type": 1, "exc_amplitude": float(a),
                                   "exc_f_start": float(f), "exc_t_ramp": ramp},
                                  label=f"{f:g} Hz {a:.3g} m"))
     results = run_batch(specs, workers=workers, progress=progress, desc="damper power")
-    power = np.full((len(freqs), len(amps)), np.nan)
+    power = np.full(rows.shape, np.nan)
     drift = np.full_like(power, np.nan)
+    impedance = np.full(power.shape, np.nan + 0j)
     for k, r in enumerate(results):
-        i, j = divmod(k, len(amps))
+        i, j = divmod(k, rows.shape[1])
         if not r.ok:
             continue
-        n, _ = windows[i]
-        p = (r["F_clamp"] * r["v_clamp"])[-n - 1:-1]
+        n, per = windows[i]
+        force, velocity = r["F_clamp"][-n - 1:-1], r["v_clamp"][-n - 1:-1]
+        p = force * velocity
         if not np.all(np.isfinite(p)):
             continue
         half = len(p) // 2
         power[i, j] = float(np.mean(p))
         drift[i, j] = float(abs(np.mean(p[:half]) - np.mean(p[half:])) / max(abs(power[i, j]), 1e-300))
-    return DamperPowerTable(freqs, amps, power, drift)
+        rotor = np.exp(-2j * np.pi * np.arange(n) / per)  # first harmonic over whole periods
+        impedance[i, j] = np.sum(force * rotor) / np.sum(velocity * rotor)
+    return DamperPowerTable(freqs, amps, power, drift, impedance)
+
+
+def clamp_amplitudes(Y, f: float, conductor: Conductor, dampers, reaction: bool = True, iterations: int = 60):
+    """Clamp amplitude [m] of each damper when the span vibrates at f [Hz] with antinode amplitude Y [m]
+    (array) away from the dampers. `dampers`: (impedance, x_d) pairs, impedance(a) [N·s/m] at clamp
+    amplitude a (vectorised), x_d [m] from the suspension clamp (a fixed point of the string).
+
+    Without the dampers' reaction (the basic method) a damper follows the undisturbed standing wave,
+    a = Y·|sin(kx_d)|. With it, the string between the clamp and the dampers is solved exactly: y = 0 at the
+    clamp, y'(x) jumps by iωZ·y/T at each damper (its force on the string), and beyond the last damper the wave
+    y cos θ + (y'/k) sin θ has the envelope maximum Y; amplitude-dependent impedances are iterated to a fixed
+    point."""
+    Y = np.asarray(Y, float)
+    k = 2 * math.pi / float(conductor.wavelength(f))
+    z_c = math.sqrt(conductor.tension * conductor.mass_per_length)  # characteristic impedance of the string
+    order = sorted(range(len(dampers)), key=lambda j: dampers[j][1])
+    amps = [Y * abs(math.sin(k * x)) for _, x in dampers]
+    if not reaction or not dampers:
+        return amps
+    for _ in range(iterations):
+        y, slope = np.zeros_like(Y, complex), np.ones_like(Y, complex)  # y and y'/k from the clamp
+        at, x_prev = [None] * len(dampers), 0.0
+        for j in order:
+            impedance, x = dampers[j]
+            c, s = math.cos(k * (x - x_prev)), math.sin(k * (x - x_prev))
+            y, slope = y * c + slope * s, -y * s + slope * c
+            at[j] = y
+            slope = slope + 1j * impedance(amps[j]) / z_c * y
+            x_prev = x
+        # largest envelope of y cos θ + slope sin θ: the largest singular value of [[Re y, Re s], [Im y, Im s]]
+        fro = np.abs(y) ** 2 + np.abs(slope) ** 2
+        det = y.real * slope.imag - slope.real * y.imag
+        envelope = np.sqrt(0.5 * (fro + np.sqrt(np.maximum(fro ** 2 - 4 * det ** 2, 0.0))))
+        new = [np.abs(at[j]) * Y / envelope for j in range(len(dampers))]
+        change = max((np.nanmax(np.abs(n - a) / np.maximum(a, 1e-300)) if np.any(np.isfinite(n)) else 0.0)
+                     for n, a in zip(new, amps))
+        amps = new
+        if change < 1e-10:
+            break
+    return amps
 
 
 def steady_amplitude(f: float, conductor: Conductor, dampers=(), turbulence: float = 0.0,
-                     n_grid: int = 400) -> float:
+                     reaction: bool = True, n_grid: int = 400) -> float:
     """Steady antinode amplitude Y [m] at frequency f [Hz]: the first root, going up from 0, of
-    P_wind - P_self - Σ P_damper. `dampers`: (power, x_d) pairs, power(a) [W] at clamp amplitude a [m]
-    (vectorised; NaN outside the damper's table, which makes the result NaN if the root lies there) for a
-    damper at x_d [m] from the clamp, where the undisturbed standing wave moves it by Y·|sin(2π x_d / λ)|."""
+    P_wind - P_self - Σ P_damper, P_damper = ½ Re Z ω² a² at each damper's clamp amplitude a
+    (`clamp_amplitudes`; `dampers`: (impedance, x_d) pairs; a NaN impedance, outside the damper's table,
+    makes the result NaN if the root lies there)."""
     D = conductor.diameter
-    lam = float(conductor.wavelength(f))
-    clamps = [(power, abs(math.sin(2 * math.pi * x_d / lam))) for power, x_d in dampers]
+    w = 2 * math.pi * f
 
     def net(Y):
         out = wind_power(f, Y, conductor, turbulence) - self_damping_power(f, Y, conductor)
-        for power, c in clamps:
-            out = out - power(np.asarray(Y, float) * c)
+        for (impedance, _), a in zip(dampers, clamp_amplitudes(Y, f, conductor, dampers, reaction)):
+            out = out - 0.5 * np.real(impedance(a)) * w ** 2 * a ** 2
         return out
 
     ys = np.concatenate([[0.0], D * np.geomspace(1e-5, ETA_MAX, n_grid)])
@@ -180,8 +238,7 @@ def steady_amplitude(f: float, conductor: Conductor, dampers=(), turbulence: flo
     if cross.size == 0 or (bad.size and bad[0] <= cross[0]):
         return math.nan
     k = cross[0]
-    return brentq(lambda y: float(net(y)), ys[k - 1], ys[k], xtol=1e-12 * D, rtol=1e-10)
-
+    return brentq(lambda y: float(net(np.array([y]))[0]), ys[k - 1], ys[k], xtol=1e-12 * D, rtol=1e-10)
 
 @dataclass
 class BalanceRow:
@@ -202,7 +259,7 @@ def energy_balance(conductor: Conductor, table: DamperPowerTable, positions, tur
     rows = []
     for i, f in enumerate(table.frequencies):
         y0 = steady_amplitude(f, conductor, (), turbulence)
-        with_damper = {x: steady_amplitude(f, conductor, [(lambda a, i=i: table.at(i, a), x)], turbulence)
+        with_damper = {x: steady_amplitude(f, conductor, [(lambda a, i=i: table.impedance_at(i, a), x)], turbulence)
                        for x in positions}
         rows.append(BalanceRow(float(f), float(f) * conductor.diameter / STROUHAL, y0, with_damper))
     return rows

@@ -2,8 +2,7 @@
 minimise the worst-case fatigue use over the aeolian band.
 
 A configuration (positions x_1 < … < x_n [m]) is judged by the energy balance at every frequency of the
-damper power table (each damper driven by the standing wave at its own position, with its own phase
-|sin(2π x_i / λ)|), the Poffenberger–Swart stress at the clamp (EI_min, the design value) and the endurance
+damper table (each damper at its own position on the wave, with the dampers' reaction on the string), the Poffenberger–Swart stress at the clamp (EI_min, the design value) and the endurance
 stress of the CIGRE safe border line: fatigue use = max over the band of σ_a / σ_endurance (≤ 1 passes).
 The search evaluates every configuration on a grid of positions, then refines the best of each damper count
 by Nelder–Mead (positions kept inside the range): its result is never worse than any grid configuration.
@@ -38,7 +37,7 @@ def evaluate(span: Conductor, conductor: ConductorType, table: DamperPowerTable,
              turbulence: float = 0.0) -> Configuration:
     """Amplitudes, stresses and fatigue use of one configuration over the table's frequencies."""
     positions = tuple(float(x) for x in positions)
-    amps = np.array([steady_amplitude(f, span, [(lambda a, i=i: table.at(i, a), x) for x in positions], turbulence)
+    amps = np.array([steady_amplitude(f, span, [(lambda a, i=i: table.impedance_at(i, a), x) for x in positions], turbulence)
                      for i, f in enumerate(table.frequencies)])
     stress = fatigue.bending_stress(amps, table.frequencies, conductor, span.tension, conductor.ei_min)
     limit = fatigue.endurance_stress(conductor.aluminium_layers)

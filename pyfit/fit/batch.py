@@ -73,6 +73,9 @@ def describe_run(r: dict) -> str:
     if "error" in r:
         return f"{name}: failed: {r['error']}"
     text = f"{name}: objective {r['objective']:.3g} after {r['true_evaluations']} evaluations, {r['wall_s']:.0f} s"
+    if r.get("impedance_error"):
+        text += (f"; impedance within {r['impedance_error']['magnitude_percent_max']:.2f} % in |Z| and "
+                 f"{r['impedance_error']['phase_deg_max']:.2f}° in phase")
     if r.get("recovery"):
         worst = max(abs(v) for v in r["recovery"].values())
         text += ("; relative error against the truth " + ", ".join(f"{k} {100 * v:+.2f} %" for k, v in r["recovery"].items())

@@ -15,6 +15,8 @@ from pyfit.report import plots
 from pyfit.io import benchmark_data
 from pyfit.io.data import read_measurement
 from pyfit.io.fit_config import FitConfig
+from pyfit.io.impedance import read_impedance
+from pyfit.fit.impedance_objective import ImpedanceObjective
 from pyfit.fit.objective import Objective
 from pyfit.fit.optim import baselines
 from pyfit.fit.optim.nno import nno
@@ -50,7 +52,9 @@ def _versions() -> dict:
             "numpy": np.__version__, "scipy": scipy.__version__, "pymoo": pymoo.__version__}
 
 
-def _objective(cfg: FitConfig, fmu, measurement, kind: str) -> Objective:
+def _objective(cfg: FitConfig, fmu, measurement, kind: str) -> Objective | ImpedanceObjective:
+    if kind == "impedance":
+        return ImpedanceObjective(str(fmu), measurement, cfg.variables, cfg.fixed, cfg.penalty)
     return Objective(str(fmu), measurement, cfg.variables, cfg.channels, cfg.fixed, kind, cfg.segment_s,
                      cfg.warmup_s, cfg.tolerance, cfg.penalty, cfg.use_inputs, cfg.input_upsample, cfg.input_periodic)
 
@@ -62,7 +66,8 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
     out_dir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     fmu = ensure_fmu(cfg.model, fmu_dir)
-    measurement = read_measurement(cfg.target_file)
+    impedance = cfg.objective_kind == "impedance"
+    measurement = read_impedance(cfg.target_file) if impedance else read_measurement(cfg.target_file)
     obj = _objective(cfg, fmu, measurement, cfg.objective_kind)
     n = len(cfg.variables)
     history, ann = [], []
@@ -95,7 +100,8 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
     result = {
         "config": str(cfg.path), "config_text": cfg.path.read_text(), "model": cfg.model, "method": cfg.method,
         "seed": seed, "parameters": fitted, "x_unit": [float(v) for v in best_x], "objective": error,
-        "band_error_percent": obj.band_error_percent(best_x) if cfg.objective_kind != "time" else {},
+        "band_error_percent": obj.band_error_percent(best_x) if cfg.objective_kind in ("psd_band", "psd_log") else {},
+        "impedance_error": obj.errors(best_x) if impedance else {},
         "objective_kind": cfg.objective_kind, "problem": cfg.problem_key(), "stop_at": stop_at,
         "global_best_so_far": np.minimum.accumulate([h["true_error"] for h in res.history]).tolist(),
         "true_evaluations": int(n_eval), "stop_reason": stop, "wall_s": time.perf_counter() - t0,
@@ -106,7 +112,7 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
     if cfg.benchmark:
         result["benchmark_rms_db"] = benchmark_validation(obj, best_x, out_dir)
     (out_dir / "result.json").write_text(json.dumps(result, indent=1, default=float))
-    _figures(cfg, obj, best_x, history, ann, out_dir)
+    (_impedance_figures if impedance else _figures)(cfg, obj, best_x, history, ann, out_dir)
     for o in objectives.values():
         o.close()
     return result
@@ -159,3 +165,20 @@ def _figures(cfg, obj: Objective, x, history, ann, out_dir):
         plots.time_histories(out_dir / f"time_{ch.output}.png",
                              [("measured", obj.t, {ch.output: meas}), ("fitted model", res.time, {ch.output: res[ch.output]})],
                              [ch.output], units, f"{cfg.path.stem}: measured and fitted {ch.output}")
+
+
+def _impedance_figures(cfg, obj: ImpedanceObjective, x, history, ann, out_dir):
+    plots.convergence(out_dir / "convergence.png", history, ann, f"{cfg.path.stem}: convergence ({cfg.method})")
+    z, test = obj.impedance(x), obj.test
+    v = 2 * np.pi * test.frequencies[:, None] * test.amplitudes
+    curves_abs, curves_phase = [], []
+    for j in range(test.amplitudes.shape[1]):
+        label = f"{np.median(v[:, j]) * 1e3:.3g} mm/s"
+        curves_abs += [(f"measured {label}", test.frequencies, np.abs(test.impedance[:, j]), "o"),
+                       (f"fitted {label}", test.frequencies, np.abs(z[:, j]), "-")]
+        curves_phase += [(f"measured {label}", test.frequencies, np.degrees(np.angle(test.impedance[:, j])), "o"),
+                         (f"fitted {label}", test.frequencies, np.degrees(np.angle(z[:, j])), "-")]
+    plots.semilogy_curves(out_dir / "impedance_abs.png", curves_abs, "frequency [Hz]", "|Z| [N·s/m]",
+                          f"{cfg.path.stem}: clamp impedance, measured and fitted")
+    plots.semilogy_curves(out_dir / "impedance_phase.png", curves_phase, "frequency [Hz]", "phase of Z [deg]",
+                          f"{cfg.path.stem}: clamp impedance phase", log=False)

@@ -118,6 +118,18 @@ def _load_columns(csv_path, names, skip, delimiter, wanted: list[str]) -> dict[s
     return dict(zip(wanted, data.T))
 
 
+def read_csv_columns(csv_path, wanted: list[str]) -> dict[str, np.ndarray]:
+    """The named columns of a lab-style CSV (comment lines, ',' or tab, extra columns), as floats."""
+    csv_path = pathlib.Path(csv_path)
+    if not csv_path.is_file():
+        raise MeasurementError(f"{csv_path}: file not found")
+    names, skip, delimiter = _header(csv_path)
+    for w in wanted:
+        if w not in names:
+            raise MeasurementError(f"{csv_path}: no column {w!r}; columns: {', '.join(names)}")
+    return _load_columns(csv_path, names, skip, delimiter, wanted)
+
+
 def check_time(t: np.ndarray, fs: float, csv_path, side, column: str, first_row: int) -> None:
     """A time column [s] must be the uniform grid of fs within MAX_TIME_SLIP samples (rounding allowed)."""
     if len(t) < 2:

@@ -9,6 +9,9 @@ from pyfit.build.catalog import EXAMPLES
 from pyfit.io.schema import ConfigError, check_bounds, check_numbers, check_sections, check_table, fail, read_toml
 
 METHODS = ("nno", "nno+polish", "ga", "de", "polish")
+# psd_band, psd_log, time: a measured time series (pyfit.io.data); impedance: a damper characteristic test
+# (pyfit.io.impedance), DamperElement only
+OBJECTIVE_KINDS = ("psd_band", "psd_log", "time", "impedance")
 
 
 @dataclass
@@ -153,10 +156,19 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None, nominal=None) -> Fit
     fixed = {**{k: v for k, v in (nominal.parameters() if nominal else {}).items() if k not in doc["variables"]},
              **check_numbers(doc.get("experiment", {}), path, "experiment")}
     ob = check_table(doc["objective"], path, "objective", {
-        "kind": (str, False, "psd_band"), "channels": (list, True, None), "segment_s": (float, False, 8.0),
+        "kind": (str, False, "psd_band"), "channels": (list, False, []), "segment_s": (float, False, 8.0),
         "warmup_s": (float, False, 0.0), "penalty": (float, False, 10.0)})
-    if ob["kind"] not in ("psd_band", "psd_log", "time"):
-        fail(path, "objective.kind", f"unknown kind '{ob['kind']}'", "psd_band, psd_log, time")
+    if ob["kind"] not in OBJECTIVE_KINDS:
+        fail(path, "objective.kind", f"unknown kind '{ob['kind']}'", ", ".join(OBJECTIVE_KINDS))
+    if ob["kind"] == "impedance":
+        if fit["model"] != "DamperElement":
+            fail(path, "fit.model", f"an impedance objective compares the clamp impedance, which {fit['model']} "
+                 "does not have", "DamperElement")
+        if synthetic is not None:
+            fail(path, "target.synthetic", "an impedance target is a measured impedance test file "
+                 "(pyfit/io/impedance.py), not a synthetic time series")
+    elif not ob["channels"]:
+        fail(path, "objective.channels", "missing (the compared signals)")
     channels = []
     for i, ch in enumerate(ob["channels"]):
         c = check_table(ch, path, f"objective.channels[{i}]", {"output": (str, True, None), "column": (str, True, None),
@@ -191,9 +203,12 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None, nominal=None) -> Fit
     if isinstance(raw_polish.get("budget"), int):
         raw_polish["budget"] = [raw_polish["budget"]]
     pol = check_table(raw_polish, path, "polish", {"kind": ("strings", False, ["time"]), "budget": (list, False, [30])})
+    allowed_polish = ("impedance",) if ob["kind"] == "impedance" else ("psd_band", "psd_log", "time")
+    if ob["kind"] == "impedance" and "kind" not in raw_polish:
+        pol["kind"] = ["impedance"]
     for k in pol["kind"]:
-        if k not in ("psd_band", "psd_log", "time"):
-            fail(path, "polish.kind", f"unknown kind '{k}'", "psd_band, psd_log, time (or a list of them)")
+        if k not in allowed_polish:
+            fail(path, "polish.kind", f"unknown kind '{k}'", f"{', '.join(allowed_polish)} (or a list of them)")
     if len(pol["budget"]) != len(pol["kind"]) or not all(isinstance(b, int) and b > 0 for b in pol["budget"]):
         fail(path, "polish.budget", f"{pol['budget']!r} must be one positive whole number per polish.kind stage")
     ga = check_table(doc.get("ga", {}), path, "ga", {"pop_size": (int, False, 20)})

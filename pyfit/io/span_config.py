@@ -21,6 +21,7 @@
     [damper]                       # the damper FMU (DamperElement), optional
     nominal = "my_damper.toml"     # a nominal-model file (relative to this file) ...
     parameters = { k_bw1 = 900.0 } # ... and/or FMU parameters, e.g. a fit's result (these win)
+    impedance_file = "test.csv"    # or the damper's measured impedance (pyfit/io/impedance.py) instead of the FMU
     amplitudes = [1e-5, 3e-2]      # m, clamp amplitudes of the damper power table (log-spaced)
     n_amplitudes = 10
     n_frequencies = 20             # log-spaced over the aeolian band
@@ -60,6 +61,7 @@ class SpanDesign:
     turbulence: float
     climate: WindClimate
     damper_parameters: dict[str, float] = field(default_factory=dict)
+    impedance_file: pathlib.Path | None = None  # a measured impedance test used instead of the damper FMU
     amplitudes: tuple[float, float] = (1e-5, 3e-2)
     n_amplitudes: int = 10
     n_frequencies: int = 20
@@ -131,7 +133,8 @@ def load_span_design(path) -> SpanDesign:
                           _positive(path, "wind.weibull_scale", w["weibull_scale"]), speed_range, strouhal,
                           w["aeolian_fraction"])
     d = check_table(doc.get("damper", {}), path, "damper", {
-        "nominal": (str, False, None), "parameters": (dict, False, {}), "amplitudes": ("floats", False, None),
+        "nominal": (str, False, None), "parameters": (dict, False, {}), "impedance_file": (str, False, None),
+        "amplitudes": ("floats", False, None),
         "n_amplitudes": (int, False, 10), "n_frequencies": (int, False, 20)})
     params = load_nominal(path.parent / d["nominal"]).parameters() if d["nominal"] else {}
     params.update(check_numbers(d["parameters"], path, "damper.parameters"))
@@ -145,7 +148,11 @@ def load_span_design(path) -> SpanDesign:
     for key in ("n_amplitudes", "n_frequencies"):
         if d[key] < 2:
             fail(path, f"damper.{key}", f"{d[key]}", "at least 2")
+    impedance_file = path.parent / d["impedance_file"] if d["impedance_file"] else None
+    if impedance_file is not None and (params or d["nominal"]):
+        fail(path, "damper.impedance_file", "a measured impedance replaces the damper FMU: give no nominal or "
+             "parameters with it")
     return SpanDesign(path, conductor, span["length"], tension, self_damping, sd["zeta"] or 0.0, w["turbulence"],
-                      climate, params, amplitudes, d["n_amplitudes"], d["n_frequencies"], pl["max_dampers"],
+                      climate, params, impedance_file, amplitudes, d["n_amplitudes"], d["n_frequencies"], pl["max_dampers"],
                       x_range, _positive(path, "placement.step", pl["step"]),
                       _positive(path, "placement.min_spacing", pl["min_spacing"]))

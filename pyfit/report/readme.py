@@ -42,6 +42,7 @@ RESULTS = {
     "docs/results/bench_diagnose_time.md": ("results/bench/diagnose_time.md", "python bench/diagnose_time.py"),
     "docs/results/design_check.md": ("results/design_check/design_check.md",
                                      "python scripts/design_check.py configs/span_drake_300m.toml"),
+    "docs/results/verify_balance.md": ("results/verify_balance/verify_balance.md", "python scripts/verify_balance.py"),
     "docs/results/bench_importer_tolerance.md": ("results/bench/importer_tolerance.md",
                                                  "python bench/importer_tolerance.py"),
 }
