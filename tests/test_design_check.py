@@ -254,3 +254,27 @@ def test_impedance_file_errors_name_the_problem(tmp_path):
     csv = _write_impedance_test(tmp_path, [(10.0, 50.0, 40.0, 30.0)], header="freq,v0,Z,phi,comment")
     with pytest.raises(MeasurementError, match="no column 'f'"):
         read_impedance(csv)
+
+
+def test_design_check_takes_a_measured_impedance_instead_of_the_damper_fmu(tmp_path):
+    """A damper known only by its characteristic test (here a dashpot with a mass, Z = c + iωm, written as an
+    impedance test file): the design check uses the test's frequencies inside the aeolian band and runs no FMU;
+    a test that misses the band is refused by name."""
+    from pyfit.design.design_check import run_design_check, write_report
+    from pyfit.io.impedance import write_impedance
+
+    freqs = np.array([4.0, 10.0, 20.0, 40.0, 80.0])  # Hz; the band of Drake at 1-7 m/s is 6.6-49.8 Hz
+    amps = np.repeat(np.geomspace(1e-4, 3e-2, 4)[None, :], len(freqs), axis=0)
+    write_impedance(tmp_path / "test.csv", freqs, amps, (60.0 + 2j * np.pi * freqs[:, None] * 0.5) * np.ones(amps.shape))
+    text = (ROOT / "configs" / "span_drake_300m.toml").read_text()
+    text = text.replace("[damper]\n", '[damper]\nimpedance_file = "test.csv"\n').replace("max_dampers = 2", "max_dampers = 1")
+    (tmp_path / "span.toml").write_text(text)
+    result = run_design_check(load_span_design(tmp_path / "span.toml"), None, progress=False)
+    assert list(result.table.frequencies) == [10.0, 20.0, 40.0]
+    assert "measured impedance `test.csv`" in write_report(result, tmp_path / "out").read_text()
+    write_impedance(tmp_path / "test.csv", freqs[[0, 4]], amps[:2], np.full((2, 4), 60.0 + 0j))
+    with pytest.raises(ConfigError, match="fewer than two test frequencies inside the aeolian band"):
+        run_design_check(load_span_design(tmp_path / "span.toml"), None, progress=False)
+    (tmp_path / "span.toml").write_text(text.replace("[damper]\n", "[damper]\nparameters = { k_bw1 = 400.0 }\n"))
+    with pytest.raises(ConfigError, match=r"\[damper.impedance_file\] a measured impedance replaces the damper FMU"):
+        load_span_design(tmp_path / "span.toml")

@@ -1,9 +1,9 @@
 """The span design check: from a SPAN.toml and the damper FMU to a report an engineer can hand on.
 
-Steps: the aeolian band of the conductor (Strouhal × wind range / D); the damper's mean power over that band
-and a range of clamp amplitudes (DamperElement FMU, `energy_balance.damper_power_table`); steady amplitudes
-by the energy balance (CIGRE wind power with turbulence, the self-damping law, every damper at its own
-position); the Poffenberger–Swart stress at the clamp; the best positions for 1…max_dampers dampers
+Steps: the aeolian band of the conductor (Strouhal × wind range / D); the damper's clamp impedance over that
+band and a range of clamp amplitudes (the DamperElement FMU, `energy_balance.damper_power_table`, or a
+measured impedance test); steady amplitudes by the energy balance (CIGRE wind power with turbulence, the
+self-damping law, every damper at its own position, with its reaction on the string); the Poffenberger–Swart stress at the clamp; the best positions for 1…max_dampers dampers
 (`placement`); fatigue of the recommended configuration (CIGRE safe border line, IEEE 150 µε, yearly
 damage over the Weibull climate). Writes design_check.md, design_check.json, damper_power.csv and figures.
 """

@@ -2,8 +2,9 @@
 minimise the worst-case fatigue use over the aeolian band.
 
 A configuration (positions x_1 < … < x_n [m]) is judged by the energy balance at every frequency of the
-damper table (each damper at its own position on the wave, with the dampers' reaction on the string), the Poffenberger–Swart stress at the clamp (EI_min, the design value) and the endurance
-stress of the CIGRE safe border line: fatigue use = max over the band of σ_a / σ_endurance (≤ 1 passes).
+damper table (each damper at its own position on the wave, with the dampers' reaction on the string), the
+Poffenberger–Swart stress at the clamp (EI_min, the design value) and the endurance stress of the CIGRE
+safe border line: fatigue use = max over the band of σ_a / σ_endurance (≤ 1 passes).
 The search evaluates every configuration on a grid of positions, then refines the best of each damper count
 by Nelder–Mead (positions kept inside the range): its result is never worse than any grid configuration.
 """

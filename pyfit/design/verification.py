@@ -5,8 +5,10 @@ The ConductorSpan FMU applies the CIGRE wind power to mode n as an amplitude-dep
 c_w = 2 P / (ω² A²)), and the self-damping law the same way; co-simulated with the DamperElement FMU (which
 takes the span's clamp motion and returns its clamp force) from an antinode amplitude near the expected
 one until the vibration is steady. The energy balance's steady amplitude at the same frequency, for the
-same span, wind, self-damping and damper (its power table at that frequency), should agree: the balance
-neglects only the damper's reaction on the wave shape.
+same span, wind, self-damping and damper (its impedance table at that frequency, with the damper's reaction
+on the string), should agree up to what each side approximates: the balance takes the span beyond the damper
+as one standing wave, the co-simulation keeps the span's first 27 modes (the local bend at the damper is
+resolved only that far).
 """
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pyfit.design.conductor import PowerLaw
 from pyfit.design.energy_balance import Conductor, damper_power_table, steady_amplitude
 from pyfit.design.span import CONNECTIONS, span_properties
 from pyfit.runtime.cosim import cosimulate
@@ -51,9 +54,8 @@ def check_mode(span_fmu: FmuRunner, damper_fmu, mode: int, x_d: float, span_para
     sd_k = float(sp.get("sd_k", span_fmu.variables["sd_k"].start))
     law = None
     if sd_k > 0:
-        from pyfit.design.conductor import PowerLaw
-        law = (PowerLaw("span FMU", *(float(sp.get(k, span_fmu.variables[k].start)) for k in ("sd_l", "sd_m", "sd_n"))),
-               sd_k)
+        exponents = (float(sp.get(k, span_fmu.variables[k].start)) for k in ("sd_l", "sd_m", "sd_n"))
+        law = (PowerLaw("span FMU", *exponents), sd_k)
     span = Conductor(diameter, props["m_l"], props["T"], props["L"], props["zeta"], law)
     f = mode * np.sqrt(props["T"] / props["m_l"]) / (2 * props["L"])
     damper_path = damper_fmu.path if isinstance(damper_fmu, FmuRunner) else damper_fmu
