@@ -189,6 +189,16 @@ def _units_and_experiment(root: ET.Element, model: ExplicitModel, variables: lis
         ET.SubElement(root, "DefaultExperiment", attrs)
 
 
+def _variable_attributes(v: FmuVariable) -> dict[str, str]:
+    """The attributes FMI 2.0 and 3.0 share: name, value reference, causality, variability, description, initial."""
+    attrs = {"name": v.name, "valueReference": str(v.vr), "causality": v.causality, "variability": v.variability}
+    if v.description:
+        attrs["description"] = v.description
+    if v.initial:
+        attrs["initial"] = v.initial
+    return attrs
+
+
 def _bounds_and_start(v: FmuVariable) -> dict[str, str]:
     attrs = {}
     if v.nominal:
@@ -227,12 +237,7 @@ def model_description(model: ExplicitModel, ident: str, guid: str, variables: li
     _units_and_experiment(root, model, variables)
     mv = ET.SubElement(root, "ModelVariables")
     for v in variables:
-        attrs = {"name": v.name, "valueReference": str(v.vr), "causality": v.causality,
-                 "variability": v.variability}
-        if v.description:
-            attrs["description"] = v.description
-        if v.initial:
-            attrs["initial"] = v.initial
+        attrs = _variable_attributes(v)
         sv = ET.SubElement(mv, "ScalarVariable", attrs)
         tattrs = {}
         if v.type == "Real":
@@ -286,12 +291,7 @@ def model_description_fmi3(model: ExplicitModel, ident: str, guid: str, variable
     ET.SubElement(mv, "Float64", {"name": "time", "valueReference": str(time_vr), "causality": "independent",
                                   "variability": "continuous", "description": "Simulation time", "unit": "s"})
     for v in variables:
-        attrs = {"name": v.name, "valueReference": str(v.vr), "causality": v.causality,
-                 "variability": v.variability}
-        if v.description:
-            attrs["description"] = v.description
-        if v.initial:
-            attrs["initial"] = v.initial
+        attrs = _variable_attributes(v)
         if v.type == "Real" and v.unit:
             attrs["unit"] = v.unit
         if v.derivative_of is not None:
