@@ -47,7 +47,7 @@ def main() -> int:
     try:
         if args.make_datasets:
             style = datasets.LabStyle(args.excitation, tuple(args.record) if args.record else None, args.motion)
-            base = load_nominal(args.nominal).parameters() if args.nominal else None
+            base = load_nominal(args.nominal).fixed if args.nominal else None  # uncertain ones: FMU defaults
             for path in datasets.write_cases(args.make_datasets, args.model, args.seeds, style=style, base=base):
                 print(path)
             return 0

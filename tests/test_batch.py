@@ -1,7 +1,13 @@
 """Batch runs: serial, process pool and Dask give identical results; failures stay local; no leaks."""
 import os
+import pathlib
+import signal
+import subprocess
+import sys
+import time
 
 import numpy as np
+import pytest
 
 from pyfit.runtime.batch import RunSpec, run_batch, run_one
 from pyfit.runtime.fmu import FmuRunner
@@ -78,3 +84,50 @@ def test_run_one_reuses_the_instance(fmu_dir, monkeypatch):
     np.testing.assert_array_equal(a["y"], b["y"])
     # one runner in this process, and the second run found the instance the first one loaded
     assert len(batch._RUNNERS) == 1 and len(made) == 2 and made[0] == id(None) and made[1] != id(None)
+
+
+_SLEEPING_BATCH = '''
+import os, pathlib, sys, time
+from pyfit.runtime.batch import map_tasks
+
+
+def task(folder):
+    pathlib.Path(folder, str(os.getpid())).write_text("")
+    time.sleep(300)
+
+
+if __name__ == "__main__":
+    map_tasks(task, [sys.argv[1]] * 4, workers=2, progress=False)
+'''
+
+
+def _alive(pid: int) -> bool:
+    """Running (a zombie, exited but not yet reaped, counts as gone)."""
+    try:
+        return pathlib.Path(f"/proc/{pid}/status").read_text().split("State:")[1].split()[0] != "Z"
+    except (FileNotFoundError, IndexError):
+        return False
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
+def test_a_killed_batch_leaves_no_worker_processes(tmp_path, sig, measured):
+    script, pids = tmp_path / "batch.py", tmp_path / "pids"
+    script.write_text(_SLEEPING_BATCH)
+    pids.mkdir()
+    root = pathlib.Path(__file__).parents[1]
+    proc = subprocess.Popen([sys.executable, str(script), str(pids)], cwd=root,
+                            env={**os.environ, "PYTHONPATH": str(root)})
+    deadline = time.monotonic() + 120
+    while len(list(pids.iterdir())) < 2:  # both workers are inside a task
+        assert time.monotonic() < deadline and proc.poll() is None, "the batch did not start its two workers"
+        time.sleep(0.1)
+    workers = [int(p.name) for p in pids.iterdir()]
+    assert all(_alive(w) for w in workers)
+    t0 = time.monotonic()
+    proc.send_signal(sig)
+    proc.wait(timeout=30)
+    while any(_alive(w) for w in workers) and time.monotonic() - t0 < 20:
+        time.sleep(0.05)
+    measured(f"batch killed with {signal.Signals(sig).name} inside 300 s tasks: time until no worker runs [s]",
+             time.monotonic() - t0, 5.0)
+    assert not any(_alive(w) for w in workers)

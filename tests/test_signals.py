@@ -117,3 +117,20 @@ def test_daq_grade_anti_alias_fir_is_flat_where_scipy_default_is_not():
     assert np.max(np.abs(h_stop)) <= 1.2 * ripple
     _, h_default = scipy.signal.freqz(scipy.signal.firwin(201, 1 / q, window="hamming"), worN=[58.0], fs=fs_fine)
     assert 20 * np.log10(abs(h_default[0])) > 0.02
+
+
+def test_envelope_of_a_modulated_sweep_is_its_amplitude(measured):
+    """sim.envelope of A(t) sin(phi(t)) (a 5-40 Hz sweep, A a slow bump) against A(t), away from the ends (the
+    Hilbert transform's edge effect), and the envelope residual of an identical simulation is zero."""
+    from pyfit.gap.simulate import Record, envelope, envelope_residuals
+
+    fs = 500.0
+    t = np.arange(0, 20.0, 1 / fs)
+    amp = 1e-3 * (1.0 + 0.5 * np.exp(-((t - 10.0) / 2.0) ** 2))
+    y = amp * np.sin(2 * np.pi * (5.0 * t + 0.875 * t**2))
+    inner = slice(int(2 * fs), int(18 * fs))
+    measured("envelope of an amplitude-modulated 5-40 Hz sweep vs its amplitude: max relative error (2-18 s)",
+             np.max(np.abs(envelope(y, fs)[inner] / amp[inner] - 1)), 1e-4)
+    rec = Record("r", "", 1.0, fs, {"u": t}, {"y": y}, 0)
+    assert np.all(envelope_residuals({"y": y}, rec) == 0.0)
+    assert np.sum(envelope_residuals(None, rec) ** 2) == pytest.approx(100.0)  # the penalty: NRMSE 10

@@ -59,3 +59,46 @@ def state_space_modes(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> list[Mode]
     lam = lam[lam.imag > 0]
     modes = [Mode(f_n=abs(l) / (2 * np.pi), f_d=l.imag / (2 * np.pi), zeta=-l.real / abs(l)) for l in lam]
     return sorted(modes, key=lambda m: m.f_n)
+
+
+def frf_peaks(u: np.ndarray, y: np.ndarray, fs: float, band: tuple[float, float], output_order: int = 0,
+              segment_s: float | None = 8.0, prominence: float = 0.3) -> list[Mode]:
+    """Resonance peaks of a measured FRF y/u inside `band` [Hz], lowest first, from any input (sweep,
+    stepped sine, noise, multisine): the H1 estimate S_uy/S_uu from Welch segments (Hann) of segment_s
+    seconds (at most the record), or with segment_s None the ratio of the whole record's DFTs (no window:
+    exact for a response from rest that has died out by the end, however fast the sweep; noisy for a
+    random input); |H| divided by (2πf)^output_order (an acceleration output over a displacement input:
+    order 2), on the lines where the input's power is at least 1e-3 of its largest, peaks standing out by
+    `prominence` x the largest, the peak frequency refined by a parabola
+    through log|H| at the three lines around it, and the damping ratio from the half-power width
+    (zeta = Δf / (2 f_n); at least the line spacing)."""
+    import scipy.signal
+
+    seg = len(u) if segment_s is None else int(min(len(u), segment_s * fs))
+    window = "boxcar" if segment_s is None else "hann"
+    f, suu = scipy.signal.welch(u, fs, window=window, nperseg=seg)
+    _, suy = scipy.signal.csd(u, y, fs, window=window, nperseg=seg)
+    # lines where the input has power (a sweep's spectrum falls by decades outside the swept band)
+    inside = (f >= band[0]) & (f <= band[1]) & (f > 0) & (suu > 1e-3 * suu[1:].max())
+    if inside.sum() < 5:
+        return []
+    f, mag = f[inside], np.abs(suy[inside] / suu[inside]) / (2 * np.pi * f[inside]) ** output_order
+    peaks, _ = scipy.signal.find_peaks(mag, prominence=prominence * mag.max())
+    df = f[1] - f[0]
+    modes = []
+    for p in peaks:
+        f_n = f[p]
+        if 0 < p < len(f) - 1:
+            a, b, c = np.log(mag[p - 1:p + 2])
+            if a - 2 * b + c < 0:
+                f_n = f[p] + 0.5 * df * (a - c) / (a - 2 * b + c)
+        half = mag[p] / np.sqrt(2.0)
+        lo, hi = p, p
+        while lo > 0 and mag[lo] > half:
+            lo -= 1
+        while hi < len(f) - 1 and mag[hi] > half:
+            hi += 1
+        width = max(float(np.interp(half, [mag[hi], mag[hi - 1]], [f[hi], f[hi - 1]]) -
+                          np.interp(half, [mag[lo], mag[lo + 1]], [f[lo], f[lo + 1]])), df)
+        modes.append(Mode(f_n=float(f_n), f_d=float(f_n), zeta=width / (2 * f_n)))
+    return modes

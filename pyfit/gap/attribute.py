@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from pyfit.runtime.fmu import FmuRunner
+from pyfit.runtime.linearize import linear_modes
 from pyfit.fit.optim.baselines import polish
 from pyfit.gap import simulate as sim
 from pyfit.gap.systems import Effect, Scale, System
@@ -48,21 +49,28 @@ class FitTask:
     lead_periods: int = 1
     alternatives: tuple = ()  # other starts (dicts of parameter overrides): the least squares starts from the best
     threads: int = 1  # records simulated at once (one FMU instance each; the compiled loop releases the GIL)
+    continuation: bool = True  # envelopes first, then the lowest level, then all (see run_fit)
 
 
-def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, pool=None) -> np.ndarray:
-    """The calibration records' residuals, stacked. runner: one FmuRunner, or one per record when `pool` (a
-    thread pool) simulates the records at once; the result is the same either way."""
+def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, pool=None,
+             of=sim.residuals) -> np.ndarray:
+    """The calibration records' residuals (`of`: sim.residuals, or sim.envelope_residuals), stacked. runner: one
+    FmuRunner, or one per record when `pool` (a thread pool) simulates the records at once; the result is the
+    same either way."""
     runners = runner if isinstance(runner, list) else [runner] * len(records)
 
     def one(k):
-        return sim.residuals(sim.simulate(runners[k], records[k], params, upsample, lead_periods), records[k])
+        return of(sim.simulate(runners[k], records[k], params, upsample, lead_periods), records[k])
 
     return np.concatenate(list(pool.map(one, range(len(records))) if pool else map(one, range(len(records)))))
 
 
 def run_fit(task: FitTask) -> Fit:
-    """Least squares on the stacked calibration residuals from task.start within task.bounds."""
+    """Least squares on the stacked calibration residuals within task.bounds, from the best of task.start and
+    task.alternatives; with task.continuation in stages, each from the best point so far (by the residual of
+    every record): the envelopes of non-periodic records (a third of the budget), the lowest level alone (a
+    quarter), then every record. Never worse than the best start: each stage and the last least squares keep
+    the best point they evaluated."""
     t0 = time.perf_counter()
     threads = max(1, min(task.threads, len(task.records)))
     runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
@@ -74,56 +82,81 @@ def run_fit(task: FitTask) -> Fit:
     def params(x):
         return {**task.fixed, **dict(zip(names, lo + np.clip(x, 0, 1) * (hi - lo)))}
 
-    def residuals(p):
-        return _stacked(runner, task.records, p, task.upsample, task.lead_periods, pool)
+    def residuals(p, records=task.records, of=sim.residuals):
+        return _stacked(runner, records, p, task.upsample, task.lead_periods, pool, of)
+
+    def cost(x):
+        return float(np.sum(residuals(params(x)) ** 2))
 
     def scaled(start):
         return np.clip((np.array([start[n] for n in names]) - lo) / (hi - lo), 0.0, 1.0)
 
-    x0, scanned = scaled(task.start), 0
-    if task.alternatives:  # find the basin: the start with the best time-domain residual
-        candidates = [x0] + [scaled({**task.start, **alt}) for alt in task.alternatives]
-        errors = [float(np.sum(residuals(params(x)) ** 2)) for x in candidates]
-        x0, scanned = candidates[int(np.argmin(errors))], len(candidates)
+    # find the basin: the start with the best time-domain residual
+    candidates = [scaled(task.start)] + [scaled({**task.start, **alt}) for alt in task.alternatives]
+    errors = [cost(x) for x in candidates]
+    x0, e0, used, budget = candidates[int(np.argmin(errors))], min(errors), len(candidates), task.budget
+    stages = []
+    if task.continuation and not any(r.periodic for r in task.records):
+        # a sweep's envelopes first (all levels): smooth in the parameters where the waveform is not
+        stages.append((task.records, sim.envelope_residuals, budget // 3))
+    levels = sorted({r.level_value for r in task.records})
+    if task.continuation and len(levels) > 1:
+        # continuation in amplitude: the lowest level alone, where an amplitude-dependent effect is weakest
+        # and the residual smooth in the parameters (a hardening spring jumps on a sweep at the highest level)
+        stages.append(([r for r in task.records if r.level_value == levels[0]], sim.residuals, budget // 4))
+    for records, of, part in stages:  # each stage goes on from the best point so far (on every record)
+        stage = polish(lambda x: residuals(params(x), records, of), x0, budget=part)
+        e = cost(stage.x)
+        x0, e0 = (stage.x, e) if e < e0 else (x0, e0)
+        used, budget = used + 1 + stage.n_evaluations, budget - stage.n_evaluations
     # least squares from there; it returns the best point it evaluated, so never worse than its start
-    result = polish(lambda x: residuals(params(x)), x0, budget=task.budget)
+    result = polish(lambda x: residuals(params(x)), x0, budget=budget)
     best = params(result.x)
-    err = float(np.sqrt(result.error / len(task.records)))
+    # the stacked residual's sum of squares is the weighted sum of every channel's squared NRMSE
+    channels = sum(sum(r.weights.get(k, 1.0) for k in r.outputs) for r in task.records)
+    err = float(np.sqrt(result.error / channels))
     for r in runner if isinstance(runner, list) else [runner]:
         r.close()
     if pool:
         pool.shutdown()
     return Fit(task.effect, {k: float(v) for k, v in best.items()}, names, task.n_added, err,
-               result.n_evaluations + scanned, time.perf_counter() - t0)
+               result.n_evaluations + used, time.perf_counter() - t0)
 
 
 STIFFNESS_SCAN = (0.25, 0.5, 1.0, 2.0, 4.0)  # factors on the nominal stiffness tried before the least squares
 STRENGTH_FACTORS = (0.25, 0.5, 1.0)  # factors on the screening's Gauss-Newton effect strength tried likewise
 
 
+def _covering(system: System, starts: list[dict], softened: bool = False) -> dict:
+    """Bounds that hold every start: per parameter the lowest and highest of system.bounds over them."""
+    each = [system.bounds(s, softened) for s in starts]
+    return {n: (min(b[n][0] for b in each), max(b[n][1] for b in each)) for n in each[0]}
+
+
 def nominal_task(system: System, fmu: str, records: list, budget: int, upsample: int, threads: int = 1) -> FitTask:
-    """The nominal (linear) calibration: from the system's start (the SDOF: its measured FRF; the damper: the
-    described values), the best of the stiffness scaled by STIFFNESS_SCAN, then least squares; `threads`
-    records simulated at once (it runs alone, so it may use every core)."""
-    start = system.start(records)
-    bounds = system.bounds(start)
-    scan = system.stiffness in start
-    if scan:  # let the bounds hold the whole scan
-        lo, hi = bounds[system.stiffness]
-        bounds[system.stiffness] = (min(lo, start[system.stiffness] * min(STIFFNESS_SCAN)),
-                                    max(hi, start[system.stiffness] * max(STIFFNESS_SCAN)))
-    alternatives = tuple({system.stiffness: start[system.stiffness] * f} for f in STIFFNESS_SCAN if f != 1.0) \
-        if scan else ()
-    return FitTask(fmu, tuple(records), dict(system.nominal_fixed), {n: start[n] for n in system.linear},
-                   bounds, "nominal", 0, budget, upsample, system.lead_periods, alternatives, threads)
+    """The nominal (linear) calibration: from the best (time-domain residual) of the system's start (the SDOF:
+    the FRF of all files; the damper: the described values), the starts from the data (system.data_starts:
+    each file's FRF; the lowest resonance moved onto each measured peak) and the stiffness scaled by
+    STIFFNESS_SCAN, then least squares (never worse than the best start); `threads` records simulated at
+    once (it runs alone, so it may use every core)."""
+    start = {n: v for n, v in system.start(records).items() if n in system.linear}
+    found = system.data_starts(records, lambda p: linear_modes(fmu, p))
+    scan = [{system.stiffness: start[system.stiffness] * f} for f in STIFFNESS_SCAN if f != 1.0] \
+        if system.stiffness in start else []
+    alternatives = tuple(found) + tuple(scan)
+    bounds = _covering(system, [start] + [{**start, **a} for a in alternatives])
+    return FitTask(fmu, tuple(records), dict(system.nominal_fixed), start, bounds, "nominal", 0, budget, upsample,
+                   system.lead_periods, alternatives, threads)
 
 
-def effect_start(system: System, effect: Effect, scale: Scale, nominal: dict) -> tuple[dict, dict, dict]:
-    """Start values, bounds and fixed parameters of the nominal model with `effect` added."""
-    start = {n: nominal[n] for n in system.linear}
+def effect_start(system: System, effect: Effect, scale: Scale, nominal: dict, linear: dict | None = None
+                 ) -> tuple[dict, dict, dict]:
+    """Start values, bounds and fixed parameters of the nominal model with `effect` added; the linear
+    parameters from `linear` (default: the calibrated nominal's)."""
+    start = {n: (linear or nominal)[n] for n in system.linear}
     if system.stiffness in start:  # a hysteretic element takes over part of the stiffness
-        start[system.stiffness] = nominal[system.stiffness] * (1.0 - effect.shift_stiffness)
-    bounds = system.bounds(nominal, softened=effect.shift_stiffness > 0)
+        start[system.stiffness] *= 1.0 - effect.shift_stiffness
+    bounds = _covering(system, [nominal] + ([linear] if linear else []), softened=effect.shift_stiffness > 0)
     for p in effect.params:
         lo, st, hi = p.range(scale)
         start[p.name], bounds[p.name] = st, (lo, hi)
@@ -131,14 +164,22 @@ def effect_start(system: System, effect: Effect, scale: Scale, nominal: dict) ->
 
 
 def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal: Fit, scale: Scale,
-                budget: int, upsample: int, strength: dict | None = None) -> FitTask:
+                budget: int, upsample: int, strength: dict | None = None, linear_starts: tuple = ()) -> FitTask:
     """The refit of the nominal model with `effect` added, from the best of the effect's default start and
     the screening's Gauss-Newton `strength` (parameter -> value) scaled by STRENGTH_FACTORS (the step
-    linearises an effect that is not linear in its strength: it can overshoot)."""
+    linearises an effect that is not linear in its strength: it can overshoot), each with the calibrated
+    nominal's linear parameters and with each of `linear_starts` (e.g. the linear system estimated from the
+    lowest level, where an amplitude-dependent effect is weakest: the nominal's compromise over all levels
+    can be far from it)."""
     start, bounds, fixed = effect_start(system, effect, scale, nominal.params)
-    alternatives = tuple({n: v * f for n, v in strength.items()} for f in STRENGTH_FACTORS) if strength else ()
+    strengths = [{}] + [{n: v * f for n, v in strength.items()} for f in STRENGTH_FACTORS] if strength else [{}]
+    alternatives = [s for s in strengths if s]
+    for linear in linear_starts:
+        lin_start, lin_bounds, _ = effect_start(system, effect, scale, nominal.params, linear)
+        bounds = {n: (min(bounds[n][0], lin_bounds[n][0]), max(bounds[n][1], lin_bounds[n][1])) for n in bounds}
+        alternatives += [{**{n: lin_start[n] for n in system.linear}, **s} for s in strengths]
     return FitTask(fmu, tuple(records), {**system.nominal_fixed, **fixed}, start, bounds, effect.name,
-                   len(effect.params), budget, upsample, system.lead_periods, alternatives)
+                   len(effect.params), budget, upsample, system.lead_periods, tuple(alternatives))
 
 
 def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int, effects: list,

@@ -45,7 +45,7 @@ class DiagnoseConfig:
     min_shrink_pct: float = 50.0  # the best effect must shrink the gap by this much to be chosen
     explain_factor: float = 3.0  # ... and bring the held-out NRMSE within explain_factor x the noise floor
     explain_margin: float = 0.02  # ... or within the floor + explain_margin (the absolute criterion)
-    nominal_max_nrmse: float = 0.8  # a nominal whose calibration NRMSE exceeds this "does not fit"
+    nominal_max_nrmse: float = 0.8  # a nominal whose NRMSE on its best calibration file exceeds this "does not fit"
 
 
 _SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
@@ -212,9 +212,9 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     stage("where (nominal gap)")
     screening, fits = {}, {}
     effects = cfg.effects or list(system.effects)
-    # nothing to attribute when the nominal model fits the held-out files within their noise, or does not fit
-    # even its own calibration files
-    if gap["significant"] and nominal.calibration_nrmse <= cfg.nominal_max_nrmse:
+    # nothing to attribute when the nominal model fits the held-out files within their noise, or fits none of
+    # its own calibration files
+    if gap["significant"] and report.best_calibration_nrmse(gap)[0] <= cfg.nominal_max_nrmse:
         screening_path = out / "fits" / "screening.json"
         stored = json.loads(screening_path.read_text()) if screening_path.is_file() else {}
         if stored.get("key") == key and "strengths" in stored:
@@ -223,6 +223,9 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
             screening, strengths = screen(system, fmu, cal, nominal, scale, cfg.upsample, effects)
             screening_path.write_text(json.dumps({"key": key, "fractions": screening, "strengths": strengths},
                                                  indent=1))
+        # the linear system where an amplitude-dependent effect is weakest: the lowest calibration level's
+        lowest = min(cal, key=lambda r: r.level_value)
+        linear_starts = tuple(system.data_starts([lowest], lambda p: linear_modes(fmu, p)))
         stage("screening")
         jobs = []
         for name in effects:
@@ -230,7 +233,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
             fits[name] = _stored(path, key)
             if fits[name] is None:
                 jobs.append((effect_task(system, system.effects[name], fmu, cal, nominal, scale, cfg.refit_budget,
-                                         cfg.upsample, strengths.get(name)), str(path), key))
+                                         cfg.upsample, strengths.get(name), linear_starts), str(path), key))
         for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="refits"):
             fits[fit.effect] = fit
         for name, f in fits.items():  # an effect is judged on the held-out files only

@@ -108,3 +108,27 @@ def residuals(sim: dict | None, rec: Record, penalty: float = 10.0) -> np.ndarra
         scale = np.sqrt(np.mean(y**2)) * np.sqrt(len(y)) / np.sqrt(rec.weights.get(k, 1.0))
         parts.append(np.full(len(y), penalty / np.sqrt(len(y))) if sim is None else (sim[k] - y) / scale)
     return np.concatenate(parts)
+
+
+def envelope(y: np.ndarray, fs: float, cutoff_hz: float = 2.0) -> np.ndarray:
+    """Amplitude envelope of a record: |analytic signal| (Hilbert) of y minus its mean, low-passed at
+    cutoff_hz (2nd-order Butterworth, zero phase)."""
+    import scipy.signal
+
+    e = np.abs(scipy.signal.hilbert(y - np.mean(y)))
+    b, a = scipy.signal.butter(2, min(cutoff_hz / (fs / 2), 0.5))
+    return scipy.signal.filtfilt(b, a, e)
+
+
+def envelope_residuals(sim: dict | None, rec: Record, penalty: float = 10.0) -> np.ndarray:
+    """Like residuals(), on the amplitude envelopes of simulated and measured outputs. Where the waveform
+    residual of a sweep through a jump (a hardening spring) or a narrow resonance changes by a whole cycle
+    for a parameter change of a few per cent, the envelope residual grows in proportion to it: a smooth
+    target that finds the basin the waveform fit then refines."""
+    parts = []
+    for k, y in rec.outputs.items():
+        env = envelope(y, rec.fs)
+        scale = np.sqrt(np.mean(env**2)) * np.sqrt(len(y)) / np.sqrt(rec.weights.get(k, 1.0))
+        parts.append(np.full(len(y), penalty / np.sqrt(len(y))) if sim is None
+                     else (envelope(sim[k], rec.fs) - env) / scale)
+    return np.concatenate(parts)

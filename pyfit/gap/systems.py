@@ -57,6 +57,7 @@ class System:
     linear: tuple  # the nominal model's free parameters
     stiffness: str  # the one of them that a hysteretic element's tangent stiffness replaces in part
     start: callable  # records -> start values of `linear`
+    data_starts: callable  # (records, modes_of) -> other starts of `linear` from the data (see make_system)
     bounds: callable  # (start, softened) -> bounds of `linear`
     scale: callable  # (deflections, fs, nominal params) -> Scale
     effects: dict
@@ -113,6 +114,12 @@ def sdof_start(records) -> dict:
     return {"m": float(abs(m)), "c": float(abs(c)), "k": float(abs(k))}
 
 
+def sdof_file_starts(records, base: dict, modes_of) -> list[dict]:
+    """One FRF start per record (sdof_start of that file alone): with an amplitude-dependent effect, the
+    pooled FRF mixes levels and the file where the effect is weakest gives the linear system."""
+    return [{**base, **sdof_start([rec])} for rec in records]
+
+
 def sdof_bounds(start: dict, softened: bool = False) -> dict:
     """Bounds of m, c, k around a linear estimate (k lower when a hysteretic element shares the stiffness)."""
     return {"m": (0.5 * start["m"], 2.0 * start["m"]), "c": (0.1 * start["c"], 5.0 * start["c"]),
@@ -157,6 +164,47 @@ SDOF_EFFECTS = {
 }
 
 # ---- Stockbridge damper ------------------------------------------------------------------------------------
+DAMPER_OUTPUT_ORDER = {"F_clamp": 2}  # FRF of an output over the clamp displacement: /(2πf)^order (else by name)
+
+
+def _damper_order(name: str) -> int:
+    return DAMPER_OUTPUT_ORDER.get(name, 2 if name.startswith(("acc_", "a_")) else 1 if name.startswith("v") else 0)
+
+
+def damper_modal_starts(records, base: dict, modes_of, max_starts: int = 8) -> list[dict]:
+    """Starts that put the model's lowest resonance in the excited band onto each resonance peak the records
+    show (pyfit.analysis.modal.frf_peaks of every output over the clamp displacement, from the whole record
+    and from Welch segments): EI scaled by
+    (f_peak / f_model)^2 (the stiffness matrix is proportional to EI) and the Rayleigh coefficients alpha_pd,
+    beta_pd by zeta_peak / zeta_model (each mode's damping ratio is linear in them). Peaks within 2 % of one
+    already taken are skipped; at most max_starts. modes_of: params -> the model's modes (linearised FMU)."""
+    from pyfit.analysis.modal import frf_peaks
+    from pyfit.gap.localise import excited_range
+
+    lo, hi = excited_range(records)
+    model = [m for m in modes_of(base) if lo <= m.f_n <= hi]
+    if not model or "EI" not in base:
+        return []
+    peaks = []
+    for rec in records:
+        u = rec.compared("x_base")
+        for name, y in rec.outputs.items():
+            for segment_s in (None, 8.0):  # the whole record (a sweep from rest), Welch segments (noise)
+                for p in frf_peaks(u, y, rec.fs, (lo, hi), _damper_order(name), segment_s):
+                    if all(abs(p.f_n / q.f_n - 1.0) > 0.02 for q in peaks):
+                        peaks.append(p)
+    starts = []
+    for p in peaks[:max_starts]:
+        s = dict(base)
+        s["EI"] = base["EI"] * (p.f_n / model[0].f_n) ** 2
+        ratio = float(np.clip(p.zeta / model[0].zeta, 0.2, 5.0))
+        for n in ("alpha_pd", "beta_pd"):
+            if n in s:
+                s[n] = base[n] * ratio
+        starts.append(s)
+    return starts
+
+
 def damper_bounds(start: dict, softened: bool = False) -> dict:
     """Default bounds of EI, alpha_pd, beta_pd around their start."""
     return {"EI": ((0.1 if softened else 0.3) * start["EI"], 3.0 * start["EI"]),
@@ -207,6 +255,7 @@ class _Family:
     linear: tuple  # the default uncertain parameters
     stiffness: str
     data_start: callable | None  # records -> start values from the data (None: the FMU's defaults)
+    data_starts: callable  # (records, start, modes_of) -> other starts from the data, one per file or peak
     bounds: callable
     stiffness_of: callable  # params -> the nonlinear element's nominal stiffness [N/m]
     deflection: callable  # (simulated outputs, record) -> the element's deflection [m]
@@ -218,12 +267,12 @@ class _Family:
 
 FAMILY = {
     "sdof": _Family("SDOFBoucWen", {"exc_type": 0, "alpha": 0.0, "k3": 0.0, "F_c": 0.0, "c2": 0.0},
-                    ("m", "c", "k"), "k", sdof_start, sdof_bounds, sdof_stiffness, sdof_deflection, ("y",), (),
+                    ("m", "c", "k"), "k", sdof_start, sdof_file_starts, sdof_bounds, sdof_stiffness, sdof_deflection, ("y",), (),
                     SDOF_EFFECTS, 1),
     "damper": _Family("StockbridgeDamper",
                       {"exc_type": 0, "k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "F_c1": 0.0,
                        "F_c2": 0.0, "c2_1": 0.0, "c2_2": 0.0},
-                      ("EI", "alpha_pd", "beta_pd"), "EI", None, damper_bounds, damper_stiffness, damper_deflection,
+                      ("EI", "alpha_pd", "beta_pd"), "EI", None, damper_modal_starts, damper_bounds, damper_stiffness, damper_deflection,
                       ("x1",), ("x_base", "v_base", "a_base"), DAMPER_EFFECTS, 2),
 }
 
@@ -249,6 +298,14 @@ def make_system(name: str, defaults: dict, nominal=None) -> System:
         from_data = fam.data_start(records) if fam.data_start else {}
         return {n: given.get(n, from_data.get(n, values[n])) for n in linear}
 
+    def data_starts(records, modes_of) -> list[dict]:
+        """Other starts from the data, beside start() (the user's or the FMU's values): the SDOF: each file's
+        FRF; the damper: the model's lowest resonance moved onto each measured peak. modes_of: params -> the
+        model's modes."""
+        base = start(records)
+        found = fam.data_starts(records, {**values, **base}, lambda p: modes_of({**p, **fixed, **fam.switches}))
+        return [{n: s[n] for n in linear} for s in found]
+
     def bounds(st: dict, softened: bool = False) -> dict:
         rule = fam.bounds({**values, **st}, softened)
         out = {}
@@ -266,5 +323,5 @@ def make_system(name: str, defaults: dict, nominal=None) -> System:
         p = {**values, **params}
         return deflection_scale(deflections, fs, fam.stiffness_of(p), p)
 
-    return System(name, fam.fmu, {**fam.switches, **fixed}, linear, fam.stiffness, start, bounds, scale,
+    return System(name, fam.fmu, {**fam.switches, **fixed}, linear, fam.stiffness, start, data_starts, bounds, scale,
                   fam.effects, fam.lead_periods, fam.deflection_outputs, fam.motion_inputs, fam.deflection)

@@ -33,6 +33,16 @@ RESULTS = {
                                     "python scripts/diagnose.py --make-datasets results/lab --excitation sweep "
                                     "--record a --seeds 0 && python scripts/diagnose.py --model sdof --data "
                                     "results/lab/sdof_hysteresis --out results/lab_report"),
+    "docs/results/diagnose_lab.md": ("results/diagnose_lab/summary.md",
+                                     "python scripts/diagnose.py --make-datasets results/lab_cases --excitation sweep "
+                                     "--record a --seeds 0 && python scripts/diagnose.py --cases results/lab_cases "
+                                     "--out results/diagnose_lab"),
+    "docs/results/diagnose_lab_damper.md": ("results/diagnose_lab_damper/summary.md",
+                                            "python scripts/diagnose.py --model damper --nominal "
+                                            "configs/symmetric_damper.toml --make-datasets results/lab_cases_damper "
+                                            "--excitation sweep --motion x --seeds 0 && python scripts/diagnose.py "
+                                            "--model damper --nominal configs/symmetric_damper.toml --cases "
+                                            "results/lab_cases_damper --out results/diagnose_lab_damper"),
     "docs/results/boucwen_benchmark.md": ("results/boucwen_benchmark/summary.md",
                                           "python scripts/fit.py configs/boucwen_benchmark.toml --repeats 2 "
                                           "--out results/boucwen_benchmark"),

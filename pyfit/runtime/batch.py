@@ -9,7 +9,10 @@ from __future__ import annotations
 import concurrent.futures as cf
 import multiprocessing
 import os
+import signal
 import sys
+import threading
+import time
 import pathlib
 from dataclasses import dataclass, field
 
@@ -87,14 +90,46 @@ def map_tasks(fn, items: list, workers: int | None = None, scheduler=None, progr
             # (torch, BLAS) could be holding locks at the moment of a fork
             method = "forkserver" if sys.platform.startswith("linux") else "spawn"
             ctx = multiprocessing.get_context(method)
-            with cf.ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1, mp_context=ctx) as pool:
+            pool = cf.ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1, mp_context=ctx,
+                                          initializer=_watch_parent, initargs=(os.getpid(),))
+            previous = signal.signal(signal.SIGTERM, _interrupt) \
+                if threading.current_thread() is threading.main_thread() else None
+            try:
                 futures = {pool.submit(fn, it): i for i, it in enumerate(items)}
                 for fut in cf.as_completed(futures):
                     results[futures[fut]] = fut.result()
                     bar.update()
+            except BaseException:  # interrupted or killed: stop the workers now, not after their tasks
+                for proc in list((pool._processes or {}).values()):
+                    proc.terminate()
+                pool.shutdown(wait=False, cancel_futures=True)
+                raise
+            finally:
+                pool.shutdown(wait=True)
+                if previous is not None:
+                    signal.signal(signal.SIGTERM, previous)
     finally:
         bar.close()
     return results
+
+
+def _interrupt(signum, frame):
+    """SIGTERM in the parent of a pool: unwind like Ctrl-C, so the workers are stopped."""
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
+def _watch_parent(parent_pid: int, every_s: float = 1.0) -> None:
+    """Pool worker initialiser: exit when the parent process is gone (killed with SIGKILL, which no handler
+    sees), so a killed run leaves no worker processes behind."""
+    def watch():
+        while True:
+            time.sleep(every_s)
+            try:
+                os.kill(parent_pid, 0)
+            except ProcessLookupError:
+                os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
 
 
 def run_batch(specs: list[RunSpec], workers: int | None = None, scheduler=None, progress: bool = True,
