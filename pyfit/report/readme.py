@@ -43,6 +43,11 @@ RESULTS = {
                                             "--excitation sweep --motion x --seeds 0 && python scripts/diagnose.py "
                                             "--model damper --nominal configs/symmetric_damper.toml --cases "
                                             "results/lab_cases_damper --out results/diagnose_lab_damper"),
+    "docs/results/diagnose_lab_design.md": ("results/diagnose_lab_design/summary.md",
+                                            "python scripts/diagnose.py --model damper --make-datasets "
+                                            "results/lab_cases_design --excitation sweep --motion x --seeds 0 && "
+                                            "python scripts/diagnose.py --model damper --cases results/lab_cases_design "
+                                            "--out results/diagnose_lab_design"),
     "docs/results/boucwen_benchmark.md": ("results/boucwen_benchmark/summary.md",
                                           "python scripts/fit.py configs/boucwen_benchmark.toml --repeats 2 "
                                           "--out results/boucwen_benchmark"),
