@@ -99,14 +99,17 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
     return {k: v[rec.first:] for k, v in res.values.items()} if res.ok else None
 
 
-def residuals(sim: dict | None, rec: Record, penalty: float = 10.0) -> np.ndarray:
+def residuals(sim: dict | None, rec: Record, penalty: float = 10.0, of=None) -> np.ndarray:
     """Stacked sqrt(w) (y_sim - y_meas) / RMS(y_meas) / sqrt(n) per channel (w: the channel's weight, default
-    1): its sum of squares is the weighted sum of the channels' squared NRMSE. A failed simulation gives the
+    1): its sum of squares is the weighted sum of the channels' squared NRMSE. `of`: a transform of each
+    channel's samples applied to both first (None: the samples themselves). A failed simulation gives the
     finite penalty vector."""
     parts = []
     for k, y in rec.outputs.items():
-        scale = np.sqrt(np.mean(y**2)) * np.sqrt(len(y)) / np.sqrt(rec.weights.get(k, 1.0))
-        parts.append(np.full(len(y), penalty / np.sqrt(len(y))) if sim is None else (sim[k] - y) / scale)
+        meas = y if of is None else of(y, rec.fs)
+        scale = np.sqrt(np.mean(meas**2)) * np.sqrt(len(y)) / np.sqrt(rec.weights.get(k, 1.0))
+        parts.append(np.full(len(y), penalty / np.sqrt(len(y))) if sim is None
+                     else ((sim[k] if of is None else of(sim[k], rec.fs)) - meas) / scale)
     return np.concatenate(parts)
 
 
@@ -121,14 +124,8 @@ def envelope(y: np.ndarray, fs: float, cutoff_hz: float = 2.0) -> np.ndarray:
 
 
 def envelope_residuals(sim: dict | None, rec: Record, penalty: float = 10.0) -> np.ndarray:
-    """Like residuals(), on the amplitude envelopes of simulated and measured outputs. Where the waveform
-    residual of a sweep through a jump (a hardening spring) or a narrow resonance changes by a whole cycle
-    for a parameter change of a few per cent, the envelope residual grows in proportion to it: a smooth
-    target that finds the basin the waveform fit then refines."""
-    parts = []
-    for k, y in rec.outputs.items():
-        env = envelope(y, rec.fs)
-        scale = np.sqrt(np.mean(env**2)) * np.sqrt(len(y)) / np.sqrt(rec.weights.get(k, 1.0))
-        parts.append(np.full(len(y), penalty / np.sqrt(len(y))) if sim is None
-                     else (envelope(sim[k], rec.fs) - env) / scale)
-    return np.concatenate(parts)
+    """residuals() of the amplitude envelopes. Where the waveform residual of a sweep through a jump (a
+    hardening spring) or a narrow resonance changes by a whole cycle for a parameter change of a few per
+    cent, the envelope residual grows in proportion to it: a smooth target that finds the basin the
+    waveform fit then refines."""
+    return residuals(sim, rec, penalty, of=envelope)

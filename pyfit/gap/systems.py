@@ -267,13 +267,13 @@ class _Family:
 
 FAMILY = {
     "sdof": _Family("SDOFBoucWen", {"exc_type": 0, "alpha": 0.0, "k3": 0.0, "F_c": 0.0, "c2": 0.0},
-                    ("m", "c", "k"), "k", sdof_start, sdof_file_starts, sdof_bounds, sdof_stiffness, sdof_deflection, ("y",), (),
-                    SDOF_EFFECTS, 1),
+                    ("m", "c", "k"), "k", sdof_start, sdof_file_starts, sdof_bounds, sdof_stiffness, sdof_deflection,
+                    ("y",), (), SDOF_EFFECTS, 1),
     "damper": _Family("StockbridgeDamper",
                       {"exc_type": 0, "k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "F_c1": 0.0,
                        "F_c2": 0.0, "c2_1": 0.0, "c2_2": 0.0},
-                      ("EI", "alpha_pd", "beta_pd"), "EI", None, damper_modal_starts, damper_bounds, damper_stiffness, damper_deflection,
-                      ("x1",), ("x_base", "v_base", "a_base"), DAMPER_EFFECTS, 2),
+                      ("EI", "alpha_pd", "beta_pd"), "EI", None, damper_modal_starts, damper_bounds, damper_stiffness,
+                      damper_deflection, ("x1",), ("x_base", "v_base", "a_base"), DAMPER_EFFECTS, 2),
 }
 
 
@@ -323,5 +323,5 @@ def make_system(name: str, defaults: dict, nominal=None) -> System:
         p = {**values, **params}
         return deflection_scale(deflections, fs, fam.stiffness_of(p), p)
 
-    return System(name, fam.fmu, {**fam.switches, **fixed}, linear, fam.stiffness, start, data_starts, bounds, scale,
-                  fam.effects, fam.lead_periods, fam.deflection_outputs, fam.motion_inputs, fam.deflection)
+    return System(name, fam.fmu, {**fam.switches, **fixed}, linear, fam.stiffness, start, data_starts, bounds,
+                  scale, fam.effects, fam.lead_periods, fam.deflection_outputs, fam.motion_inputs, fam.deflection)
