@@ -1,6 +1,8 @@
 """Shared fixtures: the FMUs are built once per test run from the .mo sources (shared by the xdist workers)."""
 import fcntl
+import os
 import pathlib
+import time
 
 import pytest
 
@@ -84,6 +86,14 @@ def _table(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+_SESSION_START = [0.0]
+
+
+def pytest_sessionstart(session):
+    """Note the wall-clock start, for the run time the table ends with."""
+    _SESSION_START[0] = time.monotonic()
+
+
 def pytest_sessionfinish(session, exitstatus):
     """Write the measured figures of a full run (the default test paths) in which every test passed: with
     pytest-xdist each worker leaves its rows in a JSON file and the controller writes the table, ordered by
@@ -105,4 +115,9 @@ def pytest_sessionfinish(session, exitstatus):
     if not rows or exitstatus != 0 or not full:
         return
     MEASURED_TABLE.parent.mkdir(parents=True, exist_ok=True)
-    MEASURED_TABLE.write_text(_table(sorted(rows, key=lambda m: (m["test"].split("::")[0], m["test"]))))
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    n_passed = len(reporter.stats.get("passed", [])) if reporter else 0
+    wall = time.monotonic() - _SESSION_START[0]
+    MEASURED_TABLE.write_text(_table(sorted(rows, key=lambda m: (m["test"].split("::")[0], m["test"])))
+                              + f"\nThe default run (`python -m pytest`): {n_passed} tests passed in {wall:.0f} s "
+                                f"on {os.cpu_count()} cores.\n")

@@ -1,5 +1,6 @@
 """The diagnosis on lab-style withheld-effect datasets: sweeps from rest instead of multisines, accelerometer
-outputs, a clamp motion recorded as displacement only, a damper described by its user (not the design one).
+outputs, a clamp motion recorded as displacement only or as acceleration only, a damper described by its user
+(not the design one).
 Default budgets (what a user runs). Slow (minutes per case): `python -m pytest -m slow tests/test_gap_lab.py`."""
 import pathlib
 
@@ -43,3 +44,17 @@ def test_described_damper_clamp_sweeps_recorded_as_displacement(tmp_path, fmu_di
                       nominal=SYMMETRIC)
     _check(rep, effect, measured, "symmetric damper (1 kg, 0.15 m, described), constant-velocity clamp sweeps, "
                                   "clamp displacement only")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("effect", [
+    "hysteresis", "cubic_stiffness", "quadratic_damping", "mass_eccentricity", "none",
+    pytest.param("coulomb_friction", marks=pytest.mark.xfail(strict=True, reason=(
+        "found (ranked first) but not named: the candidate's fixed regularising velocity (1e-3 x the element's "
+        "velocity RMS) differs from the data's 1e-3 m/s, which accelerations resolve; see the README")))])
+def test_design_damper_sweeps_recorded_by_accelerometers(tmp_path, fmu_dir, effect, measured):
+    data = datasets.write_dataset(tmp_path / "data", datasets.DAMPER, effect,
+                                  style=datasets.LabStyle("sweep", outputs=("acc_x1", "acc_x2"), motion="a"))
+    rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
+    _check(rep, effect, measured, "design damper, constant-velocity clamp sweeps, accelerometers on the clamp "
+                                  "and on both masses")

@@ -4,7 +4,6 @@ The .mo files are the single source of truth; this module only reads them.
 """
 from __future__ import annotations
 
-import copy
 import pathlib
 import re
 from dataclasses import dataclass, field
@@ -18,7 +17,8 @@ if not hasattr(ca.MX, "__div__"):
 from pyfit.build.catalog import ModelicaError  # noqa: E402
 from pymoca import parser as mo_parser  # noqa: E402
 from pymoca import tree as mo_tree  # noqa: E402
-from pymoca.backends.casadi.api import generate_model  # noqa: E402
+from pymoca import ast as mo_ast  # noqa: E402
+from pymoca.backends.casadi import generator as mo_generator  # noqa: E402
 
 
 @dataclass
@@ -110,15 +110,14 @@ def load(library: pathlib.Path, model_name: str) -> FlatModel:
     original = _find_class(tree, model_name)
     annotation = _annotation_to_dict(original.annotation)
     try:
-        flat = mo_tree.flatten(copy.deepcopy(tree), model_name)
-        model = generate_model(tree, model_name, {"check_balanced": False, "expand_vectors": True})
+        flat = mo_tree.flatten(tree, mo_ast.ComponentRef.from_string(model_name))
+        flat_class = list(flat.classes.values())[0]
+        descriptions = {name: (sym.comment or "") for name, sym in flat_class.symbols.items()}
+        protected = {name for name, sym in flat_class.symbols.items()
+                     if str(getattr(sym, "visibility", "")).upper().endswith("PROTECTED")}
+        model = _generate(flat, model_name)
     except Exception as exc:
         raise ModelicaError(f"{model_name}: pymoca could not flatten the model: {exc}") from exc
-    flat_class = list(flat.classes.values())[0]
-    descriptions = {name: (sym.comment or "") for name, sym in flat_class.symbols.items()}
-    protected = {name for name, sym in flat_class.symbols.items()
-                 if str(getattr(sym, "visibility", "")).upper().endswith("PROTECTED")}
-
     outputs = set(model.outputs)
     variables: list[Variable] = []
     for kind, group in (("state", model.states), ("algebraic", model.alg_states), ("input", model.inputs),
@@ -153,6 +152,18 @@ def load(library: pathlib.Path, model_name: str) -> FlatModel:
     experiment = {k: float(v) for k, v in (annotation.get("experiment") or {}).items()}
     return FlatModel(model_name, original.comment or "", variables, der_symbols, equations, model.time,
                      experiment, input_derivatives)
+
+
+def _generate(flat, model_name: str):
+    """pymoca's CasADi model of an already flattened tree (what pymoca's generate_model does after flattening
+    it itself: flattening is most of a build's front-end time, so it is done once)."""
+    options = mo_generator._merge_default_options({"check_balanced": False, "expand_vectors": True})
+    generator = mo_generator.Generator(flat, model_name, options)
+    mo_generator.GeneratorWalker().walk(generator, flat)
+    model = generator.model
+    model.simplify(options)
+    model._post_checks()
+    return model
 
 
 def _bound(v, attr: str, default: float) -> float:

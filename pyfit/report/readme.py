@@ -48,6 +48,12 @@ RESULTS = {
                                             "results/lab_cases_design --excitation sweep --motion x --seeds 0 && "
                                             "python scripts/diagnose.py --model damper --cases results/lab_cases_design "
                                             "--out results/diagnose_lab_design"),
+    "docs/results/diagnose_lab_design_acc.md": ("results/diagnose_lab_design_acc/summary.md",
+                                                "python scripts/diagnose.py --model damper --make-datasets "
+                                                "results/lab_cases_design_acc --excitation sweep --record acc_x1 "
+                                                "acc_x2 --motion a --seeds 0 && python scripts/diagnose.py --model "
+                                                "damper --cases results/lab_cases_design_acc --out "
+                                                "results/diagnose_lab_design_acc"),
     "docs/results/boucwen_benchmark.md": ("results/boucwen_benchmark/summary.md",
                                           "python scripts/fit.py configs/boucwen_benchmark.toml --repeats 2 "
                                           "--out results/boucwen_benchmark"),
