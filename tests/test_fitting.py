@@ -162,6 +162,10 @@ def test_fit_batch_writes_results_and_resumes_without_redoing(tmp_path, fmu_dir)
     assert r0["true_evaluations"] == 8 and len(r0["history"]) == 8
     assert {"pyfit", "fmpy", "torch", "casadi"} <= set(r0["versions"]) and len(r0["fmu_sha256"]) == 64
     assert (files[0].parent / "convergence.png").is_file() and (out / "summary.md").is_file()
+    stages = r0["stage_s"]  # the stages partition the run: their sum is its wall time (timer calls apart)
+    assert list(stages) == ["setup (FMU, measurement, objective)", "global search (nno)",
+                            "final errors, identifiability"]
+    assert sum(stages.values()) == pytest.approx(r0["wall_s"], abs=1e-3)
     stamp = files[0].stat().st_mtime_ns
     shutil.rmtree(files[1].parent)  # as if the batch had been killed before the second run finished
     second = fit_batch([cfg], repeats=2, out=out, fmu_dir=fmu_dir, workers=1, progress=False)

@@ -72,6 +72,7 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
     n = len(cfg.variables)
     history, ann = [], []
     settings = dataclasses.replace(cfg.nno, seed=seed)
+    stage_s, t_stage = {"setup (FMU, measurement, objective)": time.perf_counter() - t0}, time.perf_counter()
     if cfg.method in ("nno", "nno+polish"):
         res = nno(obj.residuals, n, settings, transform=obj.log_ratio if cfg.nno_log_ratio else None)
         ann = [h for h in res.history if h.get("ann_error") is not None]
@@ -82,6 +83,7 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
     else:
         res = baselines.polish(obj.residuals, np.full(n, 0.5), cfg.budget)
     history = [dict(h, stage="global") for h in res.history]
+    stage_s[f"global search ({cfg.method.split('+')[0]})"], t_stage = time.perf_counter() - t_stage, time.perf_counter()
     best_x, n_eval, stop = res.x, res.n_evaluations, res.stop_reason
     objectives = {cfg.objective_kind: obj}
     final_obj = obj
@@ -93,24 +95,30 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
             pol = baselines.polish(final_obj.residuals, best_x, budget)
             history += [dict(h, stage=f"polish:{kind}", evaluations=h["evaluations"] + n_eval) for h in pol.history]
             best_x, n_eval, stop = pol.x, n_eval + pol.n_evaluations, f"{stop}+{kind}:{pol.stop_reason}"
+            stage_s[f"polish ({kind})"], t_stage = time.perf_counter() - t_stage, time.perf_counter()
     error = float(np.sum(obj.residuals(best_x) ** 2))
     ident = baselines.identifiability(final_obj.residuals, best_x, cfg.variables)
+    band_error = obj.band_error_percent(best_x) if cfg.objective_kind in ("psd_band", "psd_log") else {}
+    impedance_error = obj.errors(best_x) if impedance else {}
+    stage_s["final errors, identifiability"] = time.perf_counter() - t_stage
+    wall_s = time.perf_counter() - t0
     params = obj.params(best_x)
     fitted = {v.name: params[v.name] for v in cfg.variables}
     result = {
         "config": str(cfg.path), "config_text": cfg.path.read_text(), "model": cfg.model, "method": cfg.method,
         "seed": seed, "parameters": fitted, "x_unit": [float(v) for v in best_x], "objective": error,
-        "band_error_percent": obj.band_error_percent(best_x) if cfg.objective_kind in ("psd_band", "psd_log") else {},
-        "impedance_error": obj.errors(best_x) if impedance else {},
+        "band_error_percent": band_error, "impedance_error": impedance_error,
         "objective_kind": cfg.objective_kind, "problem": cfg.problem_key(), "stop_at": stop_at,
         "global_best_so_far": np.minimum.accumulate([h["true_error"] for h in res.history]).tolist(),
-        "true_evaluations": int(n_eval), "stop_reason": stop, "wall_s": time.perf_counter() - t0,
+        "true_evaluations": int(n_eval), "stop_reason": stop, "wall_s": wall_s, "stage_s": stage_s,
         "identifiability": asdict(ident), "recovery": recovery(fitted, cfg), "history": history,
         "versions": _versions(), "fmu_sha256": hashlib.sha256(pathlib.Path(fmu).read_bytes()).hexdigest(),
         "target": str(cfg.target_file),
     }
     if cfg.benchmark:
+        t_stage = time.perf_counter()
         result["benchmark_rms_db"] = benchmark_validation(obj, best_x, out_dir)
+        stage_s["validation on the official signals (after wall_s)"] = time.perf_counter() - t_stage
     (out_dir / "result.json").write_text(json.dumps(result, indent=1, default=float))
     (_impedance_figures if impedance else _figures)(cfg, obj, best_x, history, ann, out_dir)
     for o in objectives.values():

@@ -61,6 +61,7 @@ RESULTS = {
     "docs/results/bench_fmu_soak.md": ("results/bench/fmu_soak.md", "python bench/fmu_soak.py"),
     "docs/results/bench_eval_speed.md": ("results/bench/eval_speed.md", "python bench/eval_speed.py"),
     "docs/results/bench_diagnose_time.md": ("results/bench/diagnose_time.md", "python bench/diagnose_time.py"),
+    "docs/results/bench_fit_time.md": ("results/bench/fit_time.md", "python bench/fit_time.py"),
     "docs/results/design_check.md": ("results/design_check/design_check.md",
                                      "python scripts/design_check.py configs/span_drake_300m.toml"),
     "docs/results/verify_balance.md": ("results/verify_balance/verify_balance.md", "python scripts/verify_balance.py"),

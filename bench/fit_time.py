@@ -1,0 +1,40 @@
+"""Wall time of the Bouc-Wen benchmark fit (configs/boucwen_benchmark.toml, one seed, as `scripts/fit.py` runs
+it on this machine's cores), per stage, measured in one run, with the validation result it must keep.
+Goals: <= 60 s and <= -127 dB RMS error on the official multisine.
+
+    python bench/fit_time.py [--seed 0]
+"""
+import argparse
+import pathlib
+import sys
+import tempfile
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from pyfit.fit.batch import fit_batch  # noqa: E402
+from pyfit.report.readme import BenchReport  # noqa: E402
+
+CONFIG = ROOT / "configs" / "boucwen_benchmark.toml"
+GOAL_S, GOAL_DB = 60.0, -127.0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--fmus", default=str(ROOT / "fmus"))
+    args = ap.parse_args()
+    report = BenchReport("fit_time", ROOT)
+    with tempfile.TemporaryDirectory() as tmp:
+        (r,) = fit_batch([CONFIG], 1, pathlib.Path(tmp), pathlib.Path(args.fmus), progress=False, first_seed=args.seed)
+    if "error" in r:
+        raise SystemExit(f"the fit failed: {r['error']}")
+    stages = ", ".join(f"{k} {v:.1f} s" for k, v in r["stage_s"].items())
+    db = r["benchmark_rms_db"]["multisine"]
+    report.line(f"Bouc-Wen benchmark fit ({CONFIG.name}, seed {args.seed}, {r['true_evaluations']} FMU runs): "
+                f"{r['wall_s']:.1f} s ({stages}); goal {GOAL_S:.0f} s, ratio {r['wall_s'] / GOAL_S:.2f}; "
+                f"official multisine RMS error {db:.1f} dB (goal <= {GOAL_DB:.0f} dB: {'met' if db <= GOAL_DB else 'missed'})")
+
+
+if __name__ == "__main__":
+    main()
