@@ -53,6 +53,7 @@ def runner(fmu_dir):
 
 # ---- figures the tests measure, for the README's generated table ------------------------------------------
 _MEASURED: list[dict] = []
+_SESSION_START = time.monotonic()  # this file is imported as the test session starts: the run time's origin
 MEASURED_TABLE = ROOT / "results" / "tests.md"
 
 
@@ -86,14 +87,6 @@ def _table(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
-_SESSION_START = [0.0]
-
-
-def pytest_sessionstart(session):
-    """Note the wall-clock start, for the run time the table ends with."""
-    _SESSION_START[0] = time.monotonic()
-
-
 def pytest_sessionfinish(session, exitstatus):
     """Write the measured figures of a full run (the default test paths) in which every test passed: with
     pytest-xdist each worker leaves its rows in a JSON file and the controller writes the table, ordered by
@@ -117,7 +110,7 @@ def pytest_sessionfinish(session, exitstatus):
     MEASURED_TABLE.parent.mkdir(parents=True, exist_ok=True)
     reporter = session.config.pluginmanager.get_plugin("terminalreporter")
     n_passed = len(reporter.stats.get("passed", [])) if reporter else 0
-    wall = time.monotonic() - _SESSION_START[0]
+    wall = time.monotonic() - _SESSION_START
     MEASURED_TABLE.write_text(_table(sorted(rows, key=lambda m: (m["test"].split("::")[0], m["test"])))
                               + f"\nThe default run (`python -m pytest`): {n_passed} tests passed in {wall:.0f} s "
                                 f"on {os.cpu_count()} cores.\n")

@@ -5,7 +5,6 @@ import dataclasses
 import hashlib
 import json
 import pathlib
-import time
 from dataclasses import asdict
 
 import numpy as np
@@ -20,6 +19,7 @@ from pyfit.fit.impedance_objective import ImpedanceObjective
 from pyfit.fit.objective import Objective
 from pyfit.fit.optim import baselines
 from pyfit.fit.optim.nno import nno
+from pyfit.runtime.clock import StageClock
 from pyfit.runtime.examples import ensure_fmu
 from pyfit.reference.synthetic import SyntheticSpec, write_synthetic
 
@@ -64,7 +64,7 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
     """Fit with cfg's method and the given seed; write result.json and figures into out_dir; return the result.
     stop_at: the GA baseline stops when its error first reaches this value (the NNO-vs-GA comparison)."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    t0 = time.perf_counter()
+    clock = StageClock()
     fmu = ensure_fmu(cfg.model, fmu_dir)
     impedance = cfg.objective_kind == "impedance"
     measurement = read_impedance(cfg.target_file) if impedance else read_measurement(cfg.target_file)
@@ -72,7 +72,7 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
     n = len(cfg.variables)
     history, ann = [], []
     settings = dataclasses.replace(cfg.nno, seed=seed)
-    stage_s, t_stage = {"setup (FMU, measurement, objective)": time.perf_counter() - t0}, time.perf_counter()
+    clock.end("setup (FMU, measurement, objective)")
     if cfg.method in ("nno", "nno+polish"):
         res = nno(obj.residuals, n, settings, transform=obj.log_ratio if cfg.nno_log_ratio else None)
         ann = [h for h in res.history if h.get("ann_error") is not None]
@@ -83,7 +83,7 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
     else:
         res = baselines.polish(obj.residuals, np.full(n, 0.5), cfg.budget)
     history = [dict(h, stage="global") for h in res.history]
-    stage_s[f"global search ({cfg.method.split('+')[0]})"], t_stage = time.perf_counter() - t_stage, time.perf_counter()
+    clock.end(f"global search ({cfg.method.split('+')[0]})")
     best_x, n_eval, stop = res.x, res.n_evaluations, res.stop_reason
     objectives = {cfg.objective_kind: obj}
     final_obj = obj
@@ -95,13 +95,13 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
             pol = baselines.polish(final_obj.residuals, best_x, budget)
             history += [dict(h, stage=f"polish:{kind}", evaluations=h["evaluations"] + n_eval) for h in pol.history]
             best_x, n_eval, stop = pol.x, n_eval + pol.n_evaluations, f"{stop}+{kind}:{pol.stop_reason}"
-            stage_s[f"polish ({kind})"], t_stage = time.perf_counter() - t_stage, time.perf_counter()
+            clock.end(f"polish ({kind})")
     error = float(np.sum(obj.residuals(best_x) ** 2))
     ident = baselines.identifiability(final_obj.residuals, best_x, cfg.variables)
     band_error = obj.band_error_percent(best_x) if cfg.objective_kind in ("psd_band", "psd_log") else {}
     impedance_error = obj.errors(best_x) if impedance else {}
-    stage_s["final errors, identifiability"] = time.perf_counter() - t_stage
-    wall_s = time.perf_counter() - t0
+    clock.end("final errors, identifiability")
+    wall_s = clock.elapsed()
     params = obj.params(best_x)
     fitted = {v.name: params[v.name] for v in cfg.variables}
     result = {
@@ -110,15 +110,14 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
         "band_error_percent": band_error, "impedance_error": impedance_error,
         "objective_kind": cfg.objective_kind, "problem": cfg.problem_key(), "stop_at": stop_at,
         "global_best_so_far": np.minimum.accumulate([h["true_error"] for h in res.history]).tolist(),
-        "true_evaluations": int(n_eval), "stop_reason": stop, "wall_s": wall_s, "stage_s": stage_s,
+        "true_evaluations": int(n_eval), "stop_reason": stop, "wall_s": wall_s, "stage_s": clock.stages,
         "identifiability": asdict(ident), "recovery": recovery(fitted, cfg), "history": history,
         "versions": _versions(), "fmu_sha256": hashlib.sha256(pathlib.Path(fmu).read_bytes()).hexdigest(),
         "target": str(cfg.target_file),
     }
     if cfg.benchmark:
-        t_stage = time.perf_counter()
         result["benchmark_rms_db"] = benchmark_validation(obj, best_x, out_dir)
-        stage_s["validation on the official signals (after wall_s)"] = time.perf_counter() - t_stage
+        clock.end("validation on the official signals (after wall_s)")
     (out_dir / "result.json").write_text(json.dumps(result, indent=1, default=float))
     (_impedance_figures if impedance else _figures)(cfg, obj, best_x, history, ann, out_dir)
     for o in objectives.values():

@@ -7,11 +7,11 @@ import hashlib
 import json
 import os
 import pathlib
-import time
 from dataclasses import asdict, dataclass, fields
 
 
 from pyfit.runtime.batch import map_tasks
+from pyfit.runtime.clock import StageClock
 from pyfit.io.data import MeasurementError, read_dataset
 from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
@@ -155,13 +155,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     pyfit.io.nominal); None: the FMU's defaults (for the damper, the design 1.3 reference damper)."""
     from pyfit.gap import report
 
-    stage_s, clock = {}, time.perf_counter()
-
-    def stage(name):  # wall time of the stage that ends here [s]
-        nonlocal clock
-        now = time.perf_counter()
-        stage_s[name] = now - clock
-        clock = now
+    clock = StageClock()
 
     cfg = cfg or DiagnoseConfig()
     fmu = str(ensure_fmu(family_fmu(model), pathlib.Path(fmu_dir)))
@@ -180,7 +174,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         raise DiagnoseError(f"{data_dir}: the inputs excite {lo:.1f}-{hi:.1f} Hz but the nominal model's resonances "
                             f"are at {', '.join(f'{m.f_n:.1f}' for m in modes)} Hz; allowed: an excitation band "
                             "that holds at least one resonance (the data cannot calibrate the model otherwise)")
-    stage("reading and checking the data")
+    clock.end("reading and checking the data")
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)
     judging = ("min_gap", "noise_factor", "close_points", "min_shrink_pct", "explain_factor", "explain_margin",
@@ -196,7 +190,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         task = nominal_task(system, fmu, cal, cfg.nominal_budget, cfg.upsample,
                             threads=workers or os.cpu_count() or 1)
         nominal = _fit_and_store((task, out / "fits" / "nominal.json", key))
-    stage("nominal calibration")
+    clock.end("nominal calibration")
     deflections = []
     for r in cal:
         moved = sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods,
@@ -209,7 +203,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     sims = {"nominal": {r.name: sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods) for r in records}}
     bands = [tuple(b) for b in cfg.bands_hz] if cfg.bands_hz else localise.default_bands(records)
     gap = report.nominal_gap(sims["nominal"], records, held, bands, cfg)
-    stage("where (nominal gap)")
+    clock.end("where (nominal gap)")
     screening, fits = {}, {}
     effects = cfg.effects or list(system.effects)
     # nothing to attribute when the nominal model fits the held-out files within their noise, or fits none of
@@ -226,7 +220,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         # the linear system where an amplitude-dependent effect is weakest: the lowest calibration level's
         lowest = min(cal, key=lambda r: r.level_value)
         linear_starts = tuple(system.data_starts([lowest], lambda p: linear_modes(fmu, p)))
-        stage("screening")
+        clock.end("screening")
         jobs = []
         for name in effects:
             path = out / "fits" / f"{name}.json"
@@ -239,11 +233,11 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         for name, f in fits.items():  # an effect is judged on the held-out files only
             sims[name] = {r.name: sim.simulate(runner, r, f.params, cfg.upsample, system.lead_periods)
                           for r in held}
-        stage("refits with each effect")
+        clock.end("refits with each effect")
     result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap)
     result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample, system.lead_periods)
     runner.close()
-    stage("verdict")
-    result["stage_s"] = stage_s
+    clock.end("verdict")
+    result["stage_s"] = clock.stages
     report.write(result, records, held, sims, bands, out)
     return result
