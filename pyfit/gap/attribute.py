@@ -50,6 +50,7 @@ class FitTask:
     alternatives: tuple = ()  # other starts (dicts of parameter overrides): the least squares starts from the best
     threads: int = 1  # records simulated at once (one FMU instance each; the compiled loop releases the GIL)
     continuation: bool = True  # envelopes first, then the lowest level, then all (see run_fit)
+    log_scaled: tuple = ()  # free parameters scaled to their bounds on a log scale (positive, spanning decades)
 
 
 def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, pool=None,
@@ -76,11 +77,14 @@ def run_fit(task: FitTask) -> Fit:
     runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
     pool = ThreadPoolExecutor(threads) if threads > 1 else None
     names = list(task.start)
-    lo = np.array([task.bounds[n][0] for n in names])
-    hi = np.array([task.bounds[n][1] for n in names])
+    log = np.array([n in task.log_scaled for n in names])
+    lo = np.array([task.bounds[n][0] for n in names], float)
+    hi = np.array([task.bounds[n][1] for n in names], float)
+    lo[log], hi[log] = np.log(lo[log]), np.log(hi[log])
 
     def params(x):
-        return {**task.fixed, **dict(zip(names, lo + np.clip(x, 0, 1) * (hi - lo)))}
+        v = lo + np.clip(x, 0, 1) * (hi - lo)
+        return {**task.fixed, **dict(zip(names, np.where(log, np.exp(v), v)))}
 
     def residuals(p, records=task.records, of=sim.residuals):
         return _stacked(runner, records, p, task.upsample, task.lead_periods, pool, of)
@@ -89,7 +93,9 @@ def run_fit(task: FitTask) -> Fit:
         return float(np.sum(residuals(params(x)) ** 2))
 
     def scaled(start):
-        return np.clip((np.array([start[n] for n in names]) - lo) / (hi - lo), 0.0, 1.0)
+        v = np.array([start[n] for n in names], float)
+        v[log] = np.log(v[log])
+        return np.clip((v - lo) / (hi - lo), 0.0, 1.0)
 
     # find the basin: the start with the best time-domain residual
     candidates = [scaled(task.start)] + [scaled({**task.start, **alt}) for alt in task.alternatives]
@@ -179,7 +185,8 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
         bounds = {n: (min(bounds[n][0], lin_bounds[n][0]), max(bounds[n][1], lin_bounds[n][1])) for n in bounds}
         alternatives += [{**{n: lin_start[n] for n in system.linear}, **s} for s in strengths]
     return FitTask(fmu, tuple(records), {**system.nominal_fixed, **fixed}, start, bounds, effect.name,
-                   len(effect.params), budget, upsample, system.lead_periods, tuple(alternatives))
+                   len(effect.params), budget, upsample, system.lead_periods, tuple(alternatives),
+                   log_scaled=tuple(p.name for p in effect.params if p.shape))
 
 
 def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int, effects: list,
@@ -215,14 +222,15 @@ def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, 
         p = {**base, **fixed, **{n: start[n] for n in system.linear}}
         for prm in effect.params:
             lo, st, hi = prm.range(scale)
-            # a hysteretic element at its start (more than a stiffness there); any other a small step from it
-            p[prm.name] = st if effect.shift_stiffness > 0 else st + probe * (hi - st)
+            # a hysteretic element or a shape parameter at its start (a hysteretic element is more than a
+            # stiffness there); any other a small step from it
+            p[prm.name] = st if effect.shift_stiffness > 0 or prm.shape else st + probe * (hi - st)
         d = stacked(p) - r0
         rest, coef = unexplained(np.column_stack([J, d]))
         out[name] = 1.0 - rest / lin if lin > 0 else 0.0
         if effect.shift_stiffness == 0:  # the residual is data - model: the step is -coef along d
             strengths[name] = {}
-            for prm in effect.params:
+            for prm in (q for q in effect.params if not q.shape):
                 lo, st, hi = prm.range(scale)
                 step = probe * (hi - st)
                 strengths[name][prm.name] = float(np.clip(st - coef[-1] * step, lo, hi))

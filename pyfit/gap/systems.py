@@ -29,10 +29,13 @@ class Scale:
 
 @dataclass(frozen=True)
 class Param:
-    """A fitted parameter: name in the FMU and a function of the Scale giving (lower, start, upper)."""
+    """A fitted parameter: name in the FMU and a function of the Scale giving (lower, start, upper). A `shape`
+    parameter (positive, spanning decades) is fitted on a log scale and held at its start in the screening,
+    which probes the effect's strength only."""
 
     name: str
     range: callable
+    shape: bool = False
 
 
 @dataclass(frozen=True)
@@ -142,6 +145,10 @@ def sdof_stiffness(params: dict) -> float:
     return params["k"]
 
 
+# the friction's smoothing velocity v_s [m/s] (F = F_c tanh(v / v_s)): from near-ideal Coulomb (1e-3 of the
+# velocity RMS) to a friction that is still rounding off at half of it; started at 1e-2
+_stick_velocity = Param("v_s", lambda s: (1e-3 * s.sigma_v, 1e-2 * s.sigma_v, 0.5 * s.sigma_v), shape=True)
+
 SDOF_EFFECTS = {
     "hysteresis": Effect(
         "hysteresis",
@@ -155,8 +162,7 @@ SDOF_EFFECTS = {
         "cubic_stiffness", (Param("k3", _sym(lambda s: 0.3 * s.k / s.sigma_y**2)),),
         signature="resonance shift with amplitude squared, odd distortion"),
     "coulomb_friction": Effect(
-        "coulomb_friction", (Param("F_c", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y)),),
-        fixed=lambda s: {"v_s": 1e-3 * s.sigma_v},
+        "coulomb_friction", (Param("F_c", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y)), _stick_velocity),
         signature="damping that falls with amplitude (largest misfit at the lowest level)"),
     "quadratic_damping": Effect(
         "quadratic_damping", (Param("c2", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y / s.sigma_v**2)),),
@@ -236,8 +242,7 @@ DAMPER_EFFECTS = {
         "cubic_stiffness", _pair("k_cs1", "k_cs2", _sym(lambda s: 0.3 * s.k / s.sigma_y**2)),
         signature="resonance shifts with amplitude squared, odd distortion"),
     "coulomb_friction": Effect(
-        "coulomb_friction", _pair("F_c1", "F_c2", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y)),
-        fixed=lambda s: {"v_s": 1e-3 * s.sigma_v},
+        "coulomb_friction", _pair("F_c1", "F_c2", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y)) + (_stick_velocity,),
         signature="damping that falls with amplitude (largest misfit at the lowest level)"),
     "quadratic_damping": Effect(
         "quadratic_damping", _pair("c2_1", "c2_2", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y / s.sigma_v**2)),
