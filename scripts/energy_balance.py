@@ -1,9 +1,9 @@
 """Energy balance design check of the Stockbridge damper over the aeolian band: steady vibration amplitude
-of a span with and without the damper (wind input: CIGRE polynomial; self-damping: the span's zeta; damper:
+of a span with and without the damper (wind input: the CIGRE polynomial or a published curve; self-damping: the span's zeta; damper:
 the DamperElement FMU driven by the conductor motion at its position).
 
     python scripts/energy_balance.py [--case 30:0.002 300:0.0002] [--positions 0.5 1 1.5 2]
-        [--freqs 3 50 1] [--set NAME=VALUE ...] [--turbulence 0] [--out docs/figures/energy_balance]
+        [--freqs 3 50 1] [--set NAME=VALUE ...] [--wind cigre] [--turbulence 0] [--out docs/figures/energy_balance]
 """
 import argparse
 import pathlib
@@ -14,6 +14,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from pyfit.design import energy_balance as eb  # noqa: E402
+from pyfit.design.wind import CURVES, WindPower  # noqa: E402
 from pyfit.io.nominal import load_nominal  # noqa: E402
 from pyfit.runtime.fmu import FmuRunner  # noqa: E402
 from pyfit.runtime.examples import ensure_fmu  # noqa: E402
@@ -31,6 +32,7 @@ def main() -> int:
                     help="clamp amplitude grid of the damper power table [m] (log-spaced)")
     ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE", help="damper FMU parameters")
     ap.add_argument("--nominal", help="TOML describing your damper ([nominal] fixed and free parameters; --set wins)")
+    ap.add_argument("--wind", choices=CURVES, default="cigre", help="wind power curve (pyfit/design/wind.py)")
     ap.add_argument("--turbulence", type=float, default=0.0, help="turbulence intensity I_v [-] (0: smooth flow)")
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument("--fmus", default="fmus")
@@ -50,8 +52,9 @@ def main() -> int:
     for case in args.case:
         length, zeta = (float(x) for x in case.split(":"))
         conductor = eb.conductor_of_span(span, args.diameter, span_length=length, zeta=zeta)
-        rows = eb.energy_balance(conductor, table, args.positions, args.turbulence)
-        md = eb.write_report(rows, conductor, table, out, name=f"span_{length:g}m_zeta_{zeta:g}")
+        wind = WindPower(args.wind, args.turbulence)
+        rows = eb.energy_balance(conductor, table, args.positions, wind)
+        md = eb.write_report(rows, conductor, table, out, name=f"span_{length:g}m_zeta_{zeta:g}", wind=wind)
         print(md.read_text())
     return 0
 

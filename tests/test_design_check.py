@@ -13,6 +13,7 @@ from scipy.integrate import solve_bvp
 from pyfit.design import conductor as cd
 from pyfit.design import energy_balance as eb
 from pyfit.design import fatigue, placement
+from pyfit.design.wind import WindPower
 from pyfit.io.schema import ConfigError
 from pyfit.io.span_config import load_span_design
 
@@ -175,6 +176,8 @@ def test_span_config_errors_name_the_key(tmp_path):
         "[conductor]\ntype = 'drake'\n[span]\nlength = -3\ntension = 2e4\n": "[span.length] must be > 0",
         "[conductor]\ntype = 'drake'\n[span]\nlength = 300\ntension = 2e4\n[wind]\nstrouhal = [0.2, 0.1]\n":
             "[wind.strouhal] inverted",
+        "[conductor]\ntype = 'drake'\n[span]\nlength = 300\ntension = 2e4\n[wind]\ncurve = 'rawlins'\n":
+            "[wind.curve] unknown wind power curve 'rawlins'",
     }
     for text, expected in cases.items():
         path = tmp_path / "span.toml"
@@ -183,6 +186,10 @@ def test_span_config_errors_name_the_key(tmp_path):
             load_span_design(path)
     design = load_span_design(ROOT / "configs" / "span_drake_300m.toml")
     assert design.tension == pytest.approx(0.2 * DRAKE.rts) and design.self_damping[0].l == 2.44
+    assert design.wind.curve == "cigre" and design.wind.turbulence == 0.0
+    path.write_text("[conductor]\ntype = 'drake'\n[span]\nlength = 300\ntension = 2e4\n[wind]\n"
+                    "curve = 'brika1995'\nturbulence = 0.05\n")
+    assert load_span_design(path).wind == WindPower("brika1995", 0.05)
 
 
 def test_design_check_command_writes_the_report(fmu_dir, tmp_path):

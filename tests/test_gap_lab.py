@@ -47,11 +47,8 @@ def test_described_damper_clamp_sweeps_recorded_as_displacement(tmp_path, fmu_di
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("effect", [
-    "hysteresis", "cubic_stiffness", "quadratic_damping", "mass_eccentricity", "none",
-    pytest.param("coulomb_friction", marks=pytest.mark.xfail(strict=True, reason=(
-        "found (ranked first) but not named: the candidate's fixed regularising velocity (1e-3 x the element's "
-        "velocity RMS) differs from the data's 1e-3 m/s, which accelerations resolve; see the README")))])
+@pytest.mark.parametrize("effect", ["hysteresis", "cubic_stiffness", "coulomb_friction", "quadratic_damping",
+                                    "mass_eccentricity", "none"])
 def test_design_damper_sweeps_recorded_by_accelerometers(tmp_path, fmu_dir, effect, measured):
     data = datasets.write_dataset(tmp_path / "data", datasets.DAMPER, effect,
                                   style=datasets.LabStyle("sweep", outputs=("acc_x1", "acc_x2"), motion="a"))

@@ -2,8 +2,9 @@
 
 Steps: the aeolian band of the conductor (Strouhal × wind range / D); the damper's clamp impedance over that
 band and a range of clamp amplitudes (the DamperElement FMU, `energy_balance.damper_power_table`, or a
-measured impedance test); steady amplitudes by the energy balance (CIGRE wind power with turbulence, the
-self-damping law, every damper at its own position, with its reaction on the string); the Poffenberger–Swart stress at the clamp; the best positions for 1…max_dampers dampers
+measured impedance test); steady amplitudes by the energy balance (the wind power curve with turbulence,
+the self-damping law, every damper at its own position, with its reaction on the string); the
+Poffenberger–Swart stress at the clamp; the best positions for 1…max_dampers dampers
 (`placement`); fatigue of the recommended configuration (CIGRE safe border line, IEEE 150 µε, yearly
 damage over the Weibull climate). Writes design_check.md, design_check.json, damper_power.csv and figures.
 """
@@ -90,13 +91,13 @@ def run_design_check(design: SpanDesign, damper_fmu, workers: int | None = None,
     freqs = table.frequencies
     span = energy_balance_span(design)
     args = (span, design.conductor, table)
-    bare = placement.evaluate(*args, (), design.turbulence)
-    best = {n: placement.optimise(*args, n, design.x_range, design.step, design.turbulence, design.min_spacing)
+    bare = placement.evaluate(*args, (), design.wind)
+    best = {n: placement.optimise(*args, n, design.x_range, design.step, design.wind, design.min_spacing)
             for n in range(1, design.max_dampers + 1)}
     passing = [cfg for n, cfg in sorted(best.items()) if cfg.use <= 1.0]
     recommended = passing[0] if passing else min(best.values(), key=lambda cfg: cfg.use)
     sweep = sorted(placement.grid_search(*args, 1, placement.position_grid(design.x_range, design.step),
-                                         design.turbulence), key=lambda cfg: cfg.positions)
+                                         design.wind), key=lambda cfg: cfg.positions)
     return DesignResult(design, table, bare, best, recommended, sweep, fatigue_figures(design, recommended, freqs))
 
 
@@ -126,8 +127,8 @@ def write_report(result: DesignResult, out_dir) -> pathlib.Path:
              f"{fat['margin']:.0%}** (use: the larger of the CIGRE and IEEE uses below).", "",
              f"Conductor: D = {c.diameter * 1e3:.2f} mm, {c.mass_per_length:g} kg/m, RTS {c.rts / 1e3:.1f} kN, "
              f"EI {c.ei_min:.1f}–{c.ei_max:.0f} N·m², outer wires {c.outer_wire_diameter * 1e3:.2f} mm, "
-             f"{c.aluminium_layers} aluminium layer(s). Damper: {damper}. Self-damping: {law}. Wind: CIGRE power, turbulence "
-             f"{d.turbulence:g}; Weibull k = {d.climate.weibull_shape:g}, c = {d.climate.weibull_scale:g} m/s; "
+             f"{c.aluminium_layers} aluminium layer(s). Damper: {damper}. Self-damping: {law}. Wind: {d.wind.label}; "
+             f"Weibull k = {d.climate.weibull_shape:g}, c = {d.climate.weibull_scale:g} m/s; "
              f"aeolian {d.climate.speed_range[0]:g}–{d.climate.speed_range[1]:g} m/s, St "
              f"{d.climate.strouhal[0]:g}–{d.climate.strouhal[1]:g}: band {freqs[0]:.1f}–{freqs[-1]:.1f} Hz.", "",
              "| dampers | positions from the clamp | max σ_a [MPa] | CIGRE use (σ_a / σ_endurance) |",

@@ -5,11 +5,8 @@ puts into the span equals the power the conductor's self-damping and the damper 
 
     P_wind(f, Y) = P_self(f, Y) + Σ P_damper,i,   P_damper = ½ Re(Z) ω² a²   at each damper's clamp amplitude a.
 
-- Wind power input, per unit length: f³ D⁴ fnc(Y/D) with the CIGRE reduced-power polynomial
-  fnc(η) = (-99.73 η³ + 101.62 η² + 0.1627 η + 0.2256) / sqrt(1 + (I_v / 0.09)²)  [W/(m·Hz³·m⁴)],
-  Foti F., Martinelli L. (2018), "An enhanced unified model for the self-damping of stranded cables under
-  aeolian vibrations", J. Wind Eng. Ind. Aerodyn. 182, 72-86, eqs. (4)-(5) (I_v: turbulence intensity; 0 =
-  smooth flow, the conservative case).
+- Wind power input, per unit length: f³ D⁴ fnc(Y/D), fnc the CIGRE polynomial or a published laboratory
+  curve, lowered by turbulence (`pyfit.design.wind`).
 - Self-damping: a published power law P/L = k Y^l f^m / T^n (`pyfit.design.conductor`), or the span's
   viscous modal damping ζ (the same law the ConductorSpan FMU uses): a standing wave of antinode amplitude Y
   stores ¼ m_l ω² Y² per metre, so P_self = ½ ζ m_l ω³ Y² · L.
@@ -34,11 +31,11 @@ from scipy.optimize import brentq
 
 from pyfit.design.conductor import PowerLaw, self_damping_power_per_length
 from pyfit.design.span import span_properties
+from pyfit.design.wind import WindPower
 from pyfit.io.impedance import write_impedance
 from pyfit.report import plots
 from pyfit.runtime.batch import RunSpec, run_batch
 
-CIGRE_FNC = (-99.73, 101.62, 0.1627, 0.2256)  # W/(m·Hz³·m⁴), polynomial in Y/D, highest power first
 ETA_MAX = 1.2  # Y/D searched up to here (the CIGRE fnc turns negative above Y/D = 1.02)
 
 
@@ -68,11 +65,9 @@ def conductor_of_span(span_fmu, diameter: float = DRAKE_DIAMETER, **overrides) -
                      overrides.get("span_length", p["L"]), overrides.get("zeta", p["zeta"]))
 
 
-def wind_power(f, Y, conductor: Conductor, turbulence: float = 0.0):
+def wind_power(f, Y, conductor: Conductor, wind: WindPower = WindPower()):
     """Wind power input [W] into the whole span at frequency f [Hz] and antinode amplitude Y [m]."""
-    D = conductor.diameter
-    fnc = np.polyval(CIGRE_FNC, np.asarray(Y, float) / D) / math.sqrt(1.0 + (turbulence / 0.09) ** 2)
-    return np.asarray(f, float) ** 3 * D ** 4 * fnc * conductor.span_length
+    return wind.power_per_length(f, Y, conductor.diameter) * conductor.span_length
 
 
 def self_damping_power(f, Y, conductor: Conductor):
@@ -216,17 +211,17 @@ def clamp_amplitudes(Y, f: float, conductor: Conductor, dampers, reaction: bool 
     return amps
 
 
-def steady_amplitude(f: float, conductor: Conductor, dampers=(), turbulence: float = 0.0,
+def steady_amplitude(f: float, conductor: Conductor, dampers=(), wind: WindPower = WindPower(),
                      reaction: bool = True, n_grid: int = 400) -> float:
     """Steady antinode amplitude Y [m] at frequency f [Hz]: the first root, going up from 0, of
     P_wind - P_self - Σ P_damper, P_damper = ½ Re Z ω² a² at each damper's clamp amplitude a
     (`clamp_amplitudes`; `dampers`: (impedance, x_d) pairs; a NaN impedance, outside the damper's table,
-    makes the result NaN if the root lies there)."""
+    makes the result NaN if the root lies there; so does a wind curve not measured up to the root)."""
     D = conductor.diameter
     w = 2 * math.pi * f
 
     def net(Y):
-        out = wind_power(f, Y, conductor, turbulence) - self_damping_power(f, Y, conductor)
+        out = wind_power(f, Y, conductor, wind) - self_damping_power(f, Y, conductor)
         for (impedance, _), a in zip(dampers, clamp_amplitudes(Y, f, conductor, dampers, reaction)):
             out = out - 0.5 * np.real(impedance(a)) * w ** 2 * a ** 2
         return out
@@ -253,21 +248,22 @@ class BalanceRow:
 STROUHAL = 0.185
 
 
-def energy_balance(conductor: Conductor, table: DamperPowerTable, positions, turbulence: float = 0.0
+def energy_balance(conductor: Conductor, table: DamperPowerTable, positions, wind: WindPower = WindPower()
                    ) -> list[BalanceRow]:
     """Steady amplitudes with and without the damper at every frequency of the damper power table."""
     rows = []
     for i, f in enumerate(table.frequencies):
-        y0 = steady_amplitude(f, conductor, (), turbulence)
-        with_damper = {x: steady_amplitude(f, conductor, [(lambda a, i=i: table.impedance_at(i, a), x)], turbulence)
+        y0 = steady_amplitude(f, conductor, (), wind)
+        with_damper = {x: steady_amplitude(f, conductor, [(lambda a, i=i: table.impedance_at(i, a), x)], wind)
                        for x in positions}
         rows.append(BalanceRow(float(f), float(f) * conductor.diameter / STROUHAL, y0, with_damper))
     return rows
 
 
 def write_report(rows: list[BalanceRow], conductor: Conductor, table: DamperPowerTable, out_dir,
-                 name: str = "energy_balance") -> pathlib.Path:
-    """NAME.md (table), NAME.csv and NAME.png into out_dir; returns the md path."""
+                 name: str = "energy_balance", wind: WindPower = WindPower()) -> pathlib.Path:
+    """NAME.md (table), NAME.csv and NAME.png into out_dir (`wind`: the wind power the rows were solved
+    with, named in both); returns the md path."""
 
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -279,7 +275,7 @@ def write_report(rows: list[BalanceRow], conductor: Conductor, table: DamperPowe
                comments="", fmt="%.6g")
     c = conductor
     lines = [f"Conductor: D = {c.diameter * 1e3:.2f} mm, m = {c.mass_per_length} kg/m, T = {c.tension / 1e3:g} kN, "
-             f"span {c.span_length:g} m, self-damping ζ = {c.zeta:g}. Steady antinode amplitude Y (zero to peak) "
+             f"span {c.span_length:g} m, self-damping ζ = {c.zeta:g}, wind: {wind.label}. Steady antinode amplitude Y (zero to peak) "
              "in mm, Y/D in brackets; '—' = the balance lies beyond the damper power table.", "",
              "| f [Hz] | wind [m/s] | no damper | " + " | ".join(f"damper at {x:g} m" for x in positions) + " |",
              "|---|---|---|" + "---|" * len(positions)]
@@ -301,5 +297,5 @@ def write_report(rows: list[BalanceRow], conductor: Conductor, table: DamperPowe
     plots.semilogy_curves(out / f"{name}.png", [("no damper", f, [r.y_without * 1e3 for r in rows], "k-")] + [
         (f"damper at {x:g} m", f, [r.y_with[x] * 1e3 for r in rows], "o-") for x in positions],
         "frequency [Hz]", "steady antinode amplitude Y [mm]",
-        f"Energy balance, {c.span_length:g} m span, ζ = {c.zeta:g}: wind input (CIGRE) = self-damping + damper")
+        f"Energy balance, {c.span_length:g} m span, ζ = {c.zeta:g}: wind input = self-damping + damper")
     return md

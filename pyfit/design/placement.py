@@ -20,6 +20,7 @@ from scipy.optimize import minimize
 from pyfit.design import fatigue
 from pyfit.design.conductor import ConductorType
 from pyfit.design.energy_balance import Conductor, DamperPowerTable, steady_amplitude
+from pyfit.design.wind import WindPower
 
 
 @dataclass
@@ -35,10 +36,10 @@ class Configuration:
 
 
 def evaluate(span: Conductor, conductor: ConductorType, table: DamperPowerTable, positions,
-             turbulence: float = 0.0) -> Configuration:
+             wind: WindPower = WindPower()) -> Configuration:
     """Amplitudes, stresses and fatigue use of one configuration over the table's frequencies."""
     positions = tuple(float(x) for x in positions)
-    amps = np.array([steady_amplitude(f, span, [(lambda a, i=i: table.impedance_at(i, a), x) for x in positions], turbulence)
+    amps = np.array([steady_amplitude(f, span, [(lambda a, i=i: table.impedance_at(i, a), x) for x in positions], wind)
                      for i, f in enumerate(table.frequencies)])
     stress = fatigue.bending_stress(amps, table.frequencies, conductor, span.tension, conductor.ei_min)
     limit = fatigue.endurance_stress(conductor.aluminium_layers)
@@ -53,20 +54,20 @@ def position_grid(x_range: tuple[float, float], step: float) -> np.ndarray:
 
 
 def grid_search(span: Conductor, conductor: ConductorType, table: DamperPowerTable, n_dampers: int, grid,
-                turbulence: float = 0.0, min_spacing: float = 0.5) -> list[Configuration]:
+                wind: WindPower = WindPower(), min_spacing: float = 0.5) -> list[Configuration]:
     """Every configuration of n_dampers grid positions at least min_spacing [m] apart, best (lowest use)
     first."""
     combos = [c for c in itertools.combinations(sorted(grid), n_dampers)
               if np.all(np.diff(c) >= min_spacing - 1e-9)]
-    return sorted((evaluate(span, conductor, table, c, turbulence) for c in combos), key=lambda c: c.use)
+    return sorted((evaluate(span, conductor, table, c, wind) for c in combos), key=lambda c: c.use)
 
 
 def optimise(span: Conductor, conductor: ConductorType, table: DamperPowerTable, n_dampers: int,
-             x_range: tuple[float, float], step: float = 0.25, turbulence: float = 0.0,
+             x_range: tuple[float, float], step: float = 0.25, wind: WindPower = WindPower(),
              min_spacing: float = 0.5) -> Configuration:
     """Best configuration of n_dampers in x_range [m]: grid search at `step` [m], then Nelder–Mead from the
     best grid point (dampers at least `min_spacing` [m] apart, inside the range)."""
-    best = grid_search(span, conductor, table, n_dampers, position_grid(x_range, step), turbulence,
+    best = grid_search(span, conductor, table, n_dampers, position_grid(x_range, step), wind,
                        min_spacing)[0]
     if not math.isfinite(best.use):
         return best
@@ -75,12 +76,12 @@ def optimise(span: Conductor, conductor: ConductorType, table: DamperPowerTable,
         x = np.sort(np.asarray(x, float))
         if x[0] < x_range[0] or x[-1] > x_range[1] or np.any(np.diff(x) < min_spacing - 1e-9):
             return 1e3
-        return evaluate(span, conductor, table, x, turbulence).use
+        return evaluate(span, conductor, table, x, wind).use
 
     res = minimize(cost, np.array(best.positions), method="Nelder-Mead",
                    options={"initial_simplex": _simplex(best.positions, step / 2), "xatol": 1e-3, "fatol": 1e-5,
                             "maxfev": 60 * n_dampers})
-    refined = evaluate(span, conductor, table, np.sort(res.x), turbulence) if res.fun < best.use else best
+    refined = evaluate(span, conductor, table, np.sort(res.x), wind) if res.fun < best.use else best
     return refined if refined.use <= best.use else best
 
 

@@ -84,7 +84,8 @@ def run_fit(task: FitTask) -> Fit:
 
     def params(x):
         v = lo + np.clip(x, 0, 1) * (hi - lo)
-        return {**task.fixed, **dict(zip(names, np.where(log, np.exp(v), v)))}
+        v[log] = np.exp(v[log])
+        return {**task.fixed, **dict(zip(names, v))}
 
     def residuals(p, records=task.records, of=sim.residuals):
         return _stacked(runner, records, p, task.upsample, task.lead_periods, pool, of)

@@ -12,6 +12,7 @@
     k = 1.87                       # the law's constant (optional: estimated from the conductor)
     zeta = 2e-4                    # viscous only
     [wind]                         # all optional
+    curve = "cigre"                # wind power: a curve of pyfit.design.wind.CURVES (CIGRE or a published one)
     turbulence = 0.0               # turbulence intensity I_v [-]
     weibull_shape = 2.0
     weibull_scale = 4.0            # m/s
@@ -38,6 +39,7 @@ from dataclasses import dataclass, field
 
 from pyfit.design.conductor import CONDUCTORS, SELF_DAMPING_LAWS, ConductorType, PowerLaw, self_damping_constant
 from pyfit.design.fatigue import WindClimate
+from pyfit.design.wind import CURVES, WindPower
 from pyfit.io.nominal import load_nominal
 from pyfit.io.schema import check_bounds, check_numbers, check_sections, check_table, fail, read_toml
 
@@ -58,7 +60,7 @@ class SpanDesign:
     tension: float
     self_damping: tuple[PowerLaw, float] | None  # None: viscous with zeta
     zeta: float
-    turbulence: float
+    wind: WindPower
     climate: WindClimate
     damper_parameters: dict[str, float] = field(default_factory=dict)
     impedance_file: pathlib.Path | None = None  # a measured impedance test used instead of the damper FMU
@@ -122,9 +124,13 @@ def load_span_design(path) -> SpanDesign:
         fail(path, "self_damping.law", f"unknown law {sd['law']!r}", ", ".join([*SELF_DAMPING_LAWS, "viscous"]))
     defaults = WindClimate()
     w = check_table(doc.get("wind", {}), path, "wind", {
-        "turbulence": ("number", False, 0.0), "weibull_shape": ("number", False, defaults.weibull_shape),
+        "curve": (str, False, "cigre"), "turbulence": ("number", False, 0.0), "weibull_shape": ("number", False, defaults.weibull_shape),
         "weibull_scale": ("number", False, defaults.weibull_scale), "speed_range": ("floats", False, None),
         "strouhal": ("floats", False, None), "aeolian_fraction": ("number", False, defaults.aeolian_fraction)})
+    if w["curve"] not in CURVES:
+        fail(path, "wind.curve", f"unknown wind power curve {w['curve']!r}", ", ".join(CURVES))
+    if w["turbulence"] < 0:
+        fail(path, "wind.turbulence", f"{w['turbulence']} is negative", "a turbulence intensity ≥ 0")
     speed_range = check_bounds(w["speed_range"], path, "wind.speed_range") if w["speed_range"] else defaults.speed_range
     strouhal = check_bounds(w["strouhal"], path, "wind.strouhal") if w["strouhal"] else defaults.strouhal
     if not 0 < w["aeolian_fraction"] <= 1:
@@ -152,7 +158,8 @@ def load_span_design(path) -> SpanDesign:
     if impedance_file is not None and (params or d["nominal"]):
         fail(path, "damper.impedance_file", "a measured impedance replaces the damper FMU: give no nominal or "
              "parameters with it")
-    return SpanDesign(path, conductor, span["length"], tension, self_damping, sd["zeta"] or 0.0, w["turbulence"],
+    return SpanDesign(path, conductor, span["length"], tension, self_damping, sd["zeta"] or 0.0,
+                      WindPower(w["curve"], w["turbulence"]),
                       climate, params, impedance_file, amplitudes, d["n_amplitudes"], d["n_frequencies"], pl["max_dampers"],
                       x_range, _positive(path, "placement.step", pl["step"]),
                       _positive(path, "placement.min_spacing", pl["min_spacing"]))
