@@ -2,10 +2,12 @@
 explains it, and how far the misfit shrinks on held-out files once that effect is added.
 
     python scripts/diagnose.py --model sdof|damper --data DATASET_DIR [--nominal FILE.toml] [--config FILE.toml] [--out DIR]
-    python scripts/diagnose.py --make-datasets DIR [--seeds 0 1 2] [--excitation sweep] [--record a] [--motion x]
+    python scripts/diagnose.py --make-datasets DIR [--seeds 0 1 2] [--excitation sweep|impedance] [--record a] [--motion x]
                                                                      # the withheld-effect test cases
     python scripts/diagnose.py --benchmark --config configs/diagnose_benchmark.toml   # official Bouc-Wen data
     python scripts/diagnose.py --cases DIR [--out DIR]   # every dataset under DIR, with summary.md
+    python scripts/diagnose.py --impedance TEST.csv [--uncertainty 0.01] [--nominal FILE.toml] [--out DIR]
+                                                         # a damper's impedance test (three or more levels)
 """
 import argparse
 import json
@@ -18,6 +20,7 @@ from pyfit.io import benchmark_data  # noqa: E402
 from pyfit.gap import cases  # noqa: E402
 from pyfit.gap import datasets  # noqa: E402
 from pyfit.gap.diagnose import diagnose, load_config  # noqa: E402
+from pyfit.gap.impedance_gap import diagnose_impedance  # noqa: E402
 from pyfit.io.nominal import load_nominal  # noqa: E402
 from pyfit.io.schema import ConfigError  # noqa: E402
 
@@ -36,9 +39,14 @@ def main() -> int:
     ap.add_argument("--benchmark", action="store_true",
                     help="use the official Bouc-Wen benchmark signals (written as a dataset into OUT/data)")
     ap.add_argument("--cases", metavar="DIR", help="diagnose every dataset folder under DIR and write summary.md")
+    ap.add_argument("--impedance", metavar="TEST.csv", help="diagnose a damper's impedance test (CSV + TOML "
+                    "sidecar, kind = damper_impedance) at three or more clamp-velocity levels")
+    ap.add_argument("--uncertainty", type=float, help="with --impedance: the test's relative measurement error "
+                    "(RMS of |Z_meas/Z_true - 1|; default: `uncertainty` of the test's sidecar)")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2], help="noise seeds of the null cases")
-    ap.add_argument("--excitation", choices=["multisine", "sweep"], default="multisine",
-                    help="with --make-datasets: steady multisine periods, or a 35 s sweep from rest")
+    ap.add_argument("--excitation", choices=["multisine", "sweep", "impedance"], default="multisine",
+                    help="with --make-datasets: steady multisine periods, a 35 s sweep from rest, or (--model "
+                         "damper) an impedance test")
     ap.add_argument("--record", nargs="+", metavar="OUTPUT", help="with --make-datasets: the outputs recorded "
                     "(default: displacements; e.g. a, or acc_x1 acc_x2)")
     ap.add_argument("--motion", default="xva", help="with --make-datasets --model damper: which of the clamp's "
@@ -56,11 +64,15 @@ def main() -> int:
             cases.run_cases(args.cases, args.out, cfg, args.model, args.fmus, args.workers, args.nominal)
             print((pathlib.Path(args.out) / "summary.md").read_text())
             return 0
-        if args.benchmark:
-            args.data = benchmark_data.write_dataset(pathlib.Path(args.out) / "data")
-        if not args.data:
-            ap.error("--data is required (or --benchmark, --make-datasets)")
-        report = diagnose(args.model, args.data, args.out, cfg, args.fmus, args.workers, nominal=args.nominal)
+        if args.impedance:
+            report = diagnose_impedance(args.impedance, args.out, cfg, args.fmus, args.nominal, args.uncertainty,
+                                        args.workers)
+        else:
+            if args.benchmark:
+                args.data = benchmark_data.write_dataset(pathlib.Path(args.out) / "data")
+            if not args.data:
+                ap.error("--data is required (or --impedance, --benchmark, --make-datasets)")
+            report = diagnose(args.model, args.data, args.out, cfg, args.fmus, args.workers, nominal=args.nominal)
     except (ConfigError, ValueError, FileNotFoundError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -176,16 +176,4 @@ def _figures(cfg, obj: Objective, x, history, ann, out_dir):
 
 def _impedance_figures(cfg, obj: ImpedanceObjective, x, history, ann, out_dir):
     plots.convergence(out_dir / "convergence.png", history, ann, f"{cfg.path.stem}: convergence ({cfg.method})")
-    z, test = obj.impedance(x), obj.test
-    v = 2 * np.pi * test.frequencies[:, None] * test.amplitudes
-    curves_abs, curves_phase = [], []
-    for j in range(test.amplitudes.shape[1]):
-        label = f"{np.median(v[:, j]) * 1e3:.3g} mm/s"
-        curves_abs += [(f"measured {label}", test.frequencies, np.abs(test.impedance[:, j]), "o"),
-                       (f"fitted {label}", test.frequencies, np.abs(z[:, j]), "-")]
-        curves_phase += [(f"measured {label}", test.frequencies, np.degrees(np.angle(test.impedance[:, j])), "o"),
-                         (f"fitted {label}", test.frequencies, np.degrees(np.angle(z[:, j])), "-")]
-    plots.semilogy_curves(out_dir / "impedance_abs.png", curves_abs, "frequency [Hz]", "|Z| [N·s/m]",
-                          f"{cfg.path.stem}: clamp impedance, measured and fitted")
-    plots.semilogy_curves(out_dir / "impedance_phase.png", curves_phase, "frequency [Hz]", "phase of Z [deg]",
-                          f"{cfg.path.stem}: clamp impedance phase", log=False)
+    plots.impedance_curves(out_dir, obj.test, {"fitted": obj.impedance(x)}, f"{cfg.path.stem}: measured and fitted")

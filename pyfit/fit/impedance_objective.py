@@ -15,6 +15,19 @@ from pyfit.io.fit_config import FreeParameter
 from pyfit.io.impedance import ImpedanceTest
 
 
+def model_impedance(fmu, test: ImpedanceTest, params: dict, workers: int | None = 1) -> np.ndarray:
+    """The FMU's clamp impedance [N·s/m] at the test's frequencies and amplitudes (NaN where a run failed)."""
+    return damper_power_table(fmu, test.frequencies, test.amplitudes, params, workers=workers,
+                              progress=False).impedance
+
+
+def relative_residuals(z: np.ndarray, test: ImpedanceTest, penalty: float = 10.0) -> np.ndarray:
+    """(z − Z_meas) / |Z_meas| as real and imaginary parts, the penalty where z is not finite."""
+    rel = (z - test.impedance) / np.abs(test.impedance)
+    r = np.concatenate([rel.real.ravel(), rel.imag.ravel()])
+    return np.where(np.isfinite(r), r, penalty)
+
+
 class ImpedanceObjective:
     """Residual vector r(x) of unit-scaled parameters x; error = sum(r^2)."""
 
@@ -36,15 +49,11 @@ class ImpedanceObjective:
 
     def impedance(self, x) -> np.ndarray:
         """The FMU's clamp impedance [N·s/m] at the test's frequencies and amplitudes (NaN where a run failed)."""
-        table = damper_power_table(self.fmu, self.test.frequencies, self.test.amplitudes, self.params(x),
-                                   workers=self.workers, progress=False)
-        return table.impedance
+        return model_impedance(self.fmu, self.test, self.params(x), self.workers)
 
     def residuals(self, x) -> np.ndarray:
         """Residual vector (finite; the penalty where a simulation failed)."""
-        rel = (self.impedance(x) - self.test.impedance) / np.abs(self.test.impedance)
-        r = np.concatenate([rel.real.ravel(), rel.imag.ravel()])
-        return np.where(np.isfinite(r), r, self.penalty)
+        return relative_residuals(self.impedance(x), self.test, self.penalty)
 
     def __call__(self, x) -> float:
         return float(np.sum(self.residuals(x) ** 2))

@@ -53,6 +53,29 @@ class FitTask:
     log_scaled: tuple = ()  # free parameters scaled to their bounds on a log scale (positive, spanning decades)
 
 
+class UnitScaling:
+    """Free parameters scaled to [0, 1] within their bounds, linearly or (names in `log`) on a log scale."""
+
+    def __init__(self, names, bounds: dict, log=()):
+        self.names = list(names)
+        self.log = np.array([n in log for n in self.names], bool)
+        self.lo = np.array([bounds[n][0] for n in self.names], float)
+        self.hi = np.array([bounds[n][1] for n in self.names], float)
+        self.lo[self.log], self.hi[self.log] = np.log(self.lo[self.log]), np.log(self.hi[self.log])
+
+    def values(self, x) -> dict:
+        """Parameter values (SI) at unit-scaled x (clipped to [0, 1])."""
+        v = self.lo + np.clip(x, 0, 1) * (self.hi - self.lo)
+        v[self.log] = np.exp(v[self.log])
+        return dict(zip(self.names, v))
+
+    def scaled(self, values: dict) -> np.ndarray:
+        """Unit-scaled x of parameter values (clipped into the bounds)."""
+        v = np.array([values[n] for n in self.names], float)
+        v[self.log] = np.log(v[self.log])
+        return np.clip((v - self.lo) / (self.hi - self.lo), 0.0, 1.0)
+
+
 def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, pool=None,
              of=sim.residuals) -> np.ndarray:
     """The calibration records' residuals (`of`: sim.residuals, or sim.envelope_residuals), stacked. runner: one
@@ -77,15 +100,10 @@ def run_fit(task: FitTask) -> Fit:
     runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
     pool = ThreadPoolExecutor(threads) if threads > 1 else None
     names = list(task.start)
-    log = np.array([n in task.log_scaled for n in names])
-    lo = np.array([task.bounds[n][0] for n in names], float)
-    hi = np.array([task.bounds[n][1] for n in names], float)
-    lo[log], hi[log] = np.log(lo[log]), np.log(hi[log])
+    unit = UnitScaling(names, task.bounds, task.log_scaled)
 
     def params(x):
-        v = lo + np.clip(x, 0, 1) * (hi - lo)
-        v[log] = np.exp(v[log])
-        return {**task.fixed, **dict(zip(names, v))}
+        return {**task.fixed, **unit.values(x)}
 
     def residuals(p, records=task.records, of=sim.residuals):
         return _stacked(runner, records, p, task.upsample, task.lead_periods, pool, of)
@@ -93,13 +111,8 @@ def run_fit(task: FitTask) -> Fit:
     def cost(x):
         return float(np.sum(residuals(params(x)) ** 2))
 
-    def scaled(start):
-        v = np.array([start[n] for n in names], float)
-        v[log] = np.log(v[log])
-        return np.clip((v - lo) / (hi - lo), 0.0, 1.0)
-
     # find the basin: the start with the best time-domain residual
-    candidates = [scaled(task.start)] + [scaled({**task.start, **alt}) for alt in task.alternatives]
+    candidates = [unit.scaled(task.start)] + [unit.scaled({**task.start, **alt}) for alt in task.alternatives]
     errors = [cost(x) for x in candidates]
     x0, e0, used, budget = candidates[int(np.argmin(errors))], min(errors), len(candidates), task.budget
     stages = []

@@ -1,6 +1,7 @@
 """Run the diagnosis on every dataset folder under a root (the withheld-effect test cases) and summarise:
 per case the verdict against the withheld effect (read from truth.json only for this summary), the
-shrink, the band of largest misfit and the wall time."""
+shrink, the band of largest misfit and the wall time. A folder holding a damper impedance test (sidecar
+kind = "damper_impedance") is diagnosed on it (pyfit.gap.impedance_gap)."""
 from __future__ import annotations
 
 import json
@@ -8,6 +9,17 @@ import pathlib
 import time
 
 from pyfit.gap.diagnose import DiagnoseConfig, diagnose
+from pyfit.gap.impedance_gap import diagnose_impedance
+from pyfit.io.schema import read_toml
+
+
+def impedance_test_in(folder: pathlib.Path) -> pathlib.Path | None:
+    """The CSV of a damper impedance test in the folder (its sidecar's kind is "damper_impedance"), if any."""
+    for csv in sorted(folder.glob("*.csv")):
+        side = csv.with_suffix(".toml")
+        if side.is_file() and read_toml(side).get("kind") == "damper_impedance":
+            return csv
+    return None
 
 
 def run_cases(root, out_dir, cfg: DiagnoseConfig | None = None, model: str = "sdof", fmu_dir="fmus",
@@ -17,14 +29,21 @@ def run_cases(root, out_dir, cfg: DiagnoseConfig | None = None, model: str = "sd
     rows = []
     for case in sorted(p for p in pathlib.Path(root).iterdir() if p.is_dir() and any(p.glob("*.csv"))):
         t0 = time.perf_counter()
-        rep = diagnose(model, case, pathlib.Path(out_dir) / case.name, cfg, fmu_dir, workers, progress=False,
-                       nominal=nominal)
+        test = impedance_test_in(case)
+        if test:
+            rep = diagnose_impedance(test, pathlib.Path(out_dir) / case.name, cfg, fmu_dir, nominal, workers=workers)
+            worst = max(rep["by_frequency"], key=lambda d: d["heldout_error"])["frequency_hz"]
+            gap, floor, band = rep["heldout_error_nominal"], rep["uncertainty"], [worst, worst]
+        else:
+            rep = diagnose(model, case, pathlib.Path(out_dir) / case.name, cfg, fmu_dir, workers, progress=False,
+                           nominal=nominal)
+            gap, floor, band = rep["gap"]["overall"], rep["gap"]["noise_floor"], rep["gap"]["worst_band_hz"]
         truth = json.loads((case / "truth.json").read_text())["effect"] if (case / "truth.json").is_file() else None
         expected = None if truth in (None, "none") else truth
         top = rep["ranking"][0] if rep["ranking"] else None
         rows.append({"case": case.name, "withheld": truth, "verdict": rep["verdict"],
-                     "correct": rep["chosen_effect"] == expected, "gap": rep["gap"]["overall"],
-                     "noise_floor": rep["gap"]["noise_floor"], "worst_band_hz": rep["gap"]["worst_band_hz"],
+                     "correct": rep["chosen_effect"] == expected, "gap": gap, "noise_floor": floor,
+                     "worst_band_hz": band,
                      "shrink_pct": top["shrink_pct"] if top and rep["chosen_effect"] else None,
                      "runner_up": rep["ranking"][1]["effect"] if len(rep["ranking"]) > 1 else None,
                      "runner_up_shrink_pct": rep["ranking"][1]["shrink_pct"] if len(rep["ranking"]) > 1 else None,
@@ -43,9 +62,10 @@ def write_summary(rows: list[dict], out_dir) -> pathlib.Path:
     for r in rows:
         ru = f"{r['runner_up']} ({r['runner_up_shrink_pct']:.1f})" if r["runner_up"] else "—"
         sh = f"{r['shrink_pct']:.1f}" if r["shrink_pct"] is not None else "—"
+        lo, hi = r["worst_band_hz"]
+        band = f"{lo:.1f}" if lo == hi else f"{lo:.1f}–{hi:.1f}"
         lines.append(f"| {r['case']} | {r['withheld']} | {r['verdict']} | {'yes' if r['correct'] else 'NO'} | "
-                     f"{r['gap']:.4f} | {r['noise_floor']:.4f} | {r['worst_band_hz'][0]:.1f}–{r['worst_band_hz'][1]:.1f}"
-                     f" | {sh} | {ru} | {r['wall_s']:.0f} |")
+                     f"{r['gap']:.4f} | {r['noise_floor']:.4f} | {band} | {sh} | {ru} | {r['wall_s']:.0f} |")
     n_ok = sum(r["correct"] for r in rows)
     lines += ["", f"{n_ok} of {len(rows)} cases correct."]
     md = out / "summary.md"

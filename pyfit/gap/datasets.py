@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pyfit.io.data import write_measurement
+from pyfit.io.impedance import write_impedance
 from pyfit.analysis.excitation import Excitation, PeriodicSignal, motion_with_derivatives, multisine
 from pyfit.reference.synthetic import UNITS, SyntheticSpec, simulate_truth
 
@@ -67,13 +68,20 @@ PERIODS = 3
 
 SWEEP_LEVELS = {"SDOFBoucWen": ((10.0, 25.0, 50.0), "N"),  # force amplitude
                 "StockbridgeDamper": ((0.005, 0.01, 0.02), "m/s")}  # clamp velocity amplitude
+# a damper characteristic test (IEC 61897): frequencies [Hz] through both resonances of the design damper,
+# at the sweep levels; noise 0.5 % in |Z| and 0.3 deg in phase (RMS of |Z_meas/Z_true - 1| about 0.0073),
+# stated in the sidecar as an uncertainty of 1 %
+IMPEDANCE_FREQUENCIES_HZ = (8.0, 10.0, 13.0, 17.0, 22.0, 30.0, 40.0)
+IMPEDANCE_NOISE = (0.005, float(np.radians(0.3)))
+IMPEDANCE_UNCERTAINTY = 0.01
 
 
 @dataclass(frozen=True)
 class LabStyle:
     """How a test bench would have recorded a case: the excitation ('multisine': steady-state periods;
     'sweep': a linear sweep over the family's band from rest, sweep_s long, constant force amplitude for the
-    SDOF and constant clamp-velocity amplitude for the damper), the outputs recorded (None: the family's
+    SDOF and constant clamp-velocity amplitude for the damper; 'impedance': the damper's characteristic
+    test, see write_impedance_case), the outputs recorded (None: the family's
     displacements; e.g. ("a",) or ("acc_x1", "acc_x2") for accelerometers) and which of the clamp's x, v,
     a were recorded (the damper's shaker controller gives all three; an accelerometer only 'a')."""
 
@@ -157,6 +165,28 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     return out
 
 
+def write_impedance_case(out_dir, effect: str, seed: int = 0, base: dict | None = None) -> pathlib.Path:
+    """One withheld-effect case of the damper as a characteristic test (IEC 61897): the CasADi reference
+    damper's clamp impedance at IMPEDANCE_FREQUENCIES_HZ and the sweep levels (clamp velocity amplitudes
+    [m/s]), with IMPEDANCE_NOISE, in OUT/impedance_test.csv (+ sidecar stating IMPEDANCE_UNCERTAINTY);
+    truth.json beside it (never read by the diagnosis)."""
+    from pyfit.reference.impedance import reference_impedance
+
+    if effect not in DAMPER.withheld:
+        raise ValueError(f"effect '{effect}' unknown for {DAMPER.model}; allowed: {', '.join(DAMPER.withheld)}")
+    out = pathlib.Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    truth = _truth_params(DAMPER, effect, base or {})
+    amps, z = reference_impedance(IMPEDANCE_FREQUENCIES_HZ, SWEEP_LEVELS[DAMPER.model][0], truth,
+                                  noise=IMPEDANCE_NOISE, seed=seed)
+    write_impedance(out / "impedance_test.csv", IMPEDANCE_FREQUENCIES_HZ, amps, z,
+                    f"synthetic: CasADi reference damper (cvodes), noise {IMPEDANCE_NOISE[0]:g} relative in |Z|, "
+                    f"{np.degrees(IMPEDANCE_NOISE[1]):g} deg in phase, seed {seed}", IMPEDANCE_UNCERTAINTY)
+    (out / "truth.json").write_text(json.dumps({"effect": effect, "params": truth, "seed": seed,
+                                                "style": {"excitation": "impedance"}}, indent=1))
+    return out
+
+
 def _noise_of(family: Family, output: str, clean: np.ndarray) -> float:
     """Sensor noise [SI] of a channel: the family's displacement noise, or for another quantity the same
     fraction of its RMS as the displacement noise is of a displacement channel's RMS (about 0.3-1 %)."""
@@ -169,6 +199,11 @@ def write_cases(out_dir, family: str = "sdof", null_seeds=(0, 1, 2), periods: in
                 style: LabStyle = LabStyle(), base: dict | None = None) -> list[pathlib.Path]:
     """The test cases of a family: each effect withheld (seed 0) and the null case for every noise seed."""
     fam, out = FAMILIES[family], pathlib.Path(out_dir)
+    if style.excitation == "impedance":
+        if family != "damper":
+            raise ValueError(f"excitation 'impedance' is a damper test; the family is '{family}'")
+        return ([write_impedance_case(out / f"damper_{e}", e, base=base) for e in fam.withheld if e != "none"]
+                + [write_impedance_case(out / f"damper_none_seed{s}", "none", s, base) for s in null_seeds])
     paths = [write_dataset(out / f"{family}_{e}", fam, e, periods=periods, style=style, base=base)
              for e in fam.withheld if e != "none"]
     return paths + [write_dataset(out / f"{family}_none_seed{s}", fam, "none", seed=s, periods=periods, style=style,

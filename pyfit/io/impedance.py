@@ -9,6 +9,7 @@ like any lab export: comment lines, extra columns, ',' or tab) and a TOML sideca
     impedance = { name = "Z", unit = "N.s/m" }       # |F̂| / |v̂|, first harmonics
     phase = { name = "phi", unit = "deg" }            # of the force relative to the velocity
     notes = "..."
+    uncertainty = 0.01    # optional: the test's relative error, RMS of |Z_meas / Z_true - 1| (for diagnose.py)
 
 Every frequency must have been tested at the same number of levels. The result, an `ImpedanceTest` (each
 frequency with its own clamp amplitudes a = v / 2πf), becomes the damper table of the energy balance and the
@@ -43,6 +44,7 @@ class ImpedanceTest:
     frequencies: np.ndarray
     amplitudes: np.ndarray
     impedance: np.ndarray
+    uncertainty: float | None = None  # stated relative measurement error (RMS of |Z_meas / Z_true − 1|)
 
 
 def read_impedance(csv_path) -> ImpedanceTest:
@@ -51,7 +53,11 @@ def read_impedance(csv_path) -> ImpedanceTest:
     side = csv_path.with_suffix(".toml")
     doc = read_toml(side, MeasurementError)
     top = check_table(doc, side, "", {"kind": (str, True, None), "columns": (dict, True, None),
-                                      "notes": (str, False, "")}, MeasurementError)
+                                      "notes": (str, False, ""), "uncertainty": ("number", False, None)},
+                      MeasurementError)
+    if top["uncertainty"] is not None and not 0 < top["uncertainty"] < 1:
+        fail(side, "uncertainty", f"{top['uncertainty']!r}", "the relative error, 0 < uncertainty < 1",
+             MeasurementError)
     if top["kind"] != "damper_impedance":
         fail(side, "kind", f"{top['kind']!r} is not an impedance test", "damper_impedance", MeasurementError)
     spec = {k: (dict, k in ("frequency", "impedance", "phase"), None) for k in UNITS}
@@ -82,13 +88,15 @@ def read_impedance(csv_path) -> ImpedanceTest:
              "every frequency tested at the same number of levels", MeasurementError)
     order = np.lexsort((amplitude, f))
     shape = (len(freqs), len(f) // len(freqs))
-    return ImpedanceTest(csv_path, freqs, amplitude[order].reshape(shape), z[order].reshape(shape))
+    return ImpedanceTest(csv_path, freqs, amplitude[order].reshape(shape), z[order].reshape(shape),
+                         top["uncertainty"])
 
 
-def write_impedance(csv_path, frequencies, amplitudes, impedance, notes: str = "") -> pathlib.Path:
+def write_impedance(csv_path, frequencies, amplitudes, impedance, notes: str = "",
+                    uncertainty: float | None = None) -> pathlib.Path:
     """An impedance test file (CSV + sidecar) in the format read_impedance reads: one row per frequency [Hz]
     and clamp amplitude amplitudes[i, j] [m], with the clamp velocity amplitude [m/s], |Z| [N·s/m], the phase
-    of Z [deg] and the mean power ½ Re Z ω² a² [W]."""
+    of Z [deg] and the mean power ½ Re Z ω² a² [W]; `uncertainty`: the stated relative error, if known."""
     csv_path = pathlib.Path(csv_path)
     f = np.repeat(np.asarray(frequencies, float)[:, None], np.shape(amplitudes)[1], axis=1)
     a, z = np.asarray(amplitudes, float), np.asarray(impedance, complex)
@@ -99,7 +107,7 @@ def write_impedance(csv_path, frequencies, amplitudes, impedance, notes: str = "
                                      "impedance_phase_deg,power_w", comments="", fmt="%.9g")
     csv_path.with_suffix(".toml").write_text(
         'kind = "damper_impedance"\n'
-        f"notes = {json.dumps(notes)}\n[columns]\n"
+        f"notes = {json.dumps(notes)}\n" + (f"uncertainty = {uncertainty!r}\n" if uncertainty else "") + "[columns]\n"
         'frequency = { name = "frequency_hz", unit = "Hz" }\n'
         'displacement = { name = "clamp_amplitude_m", unit = "m" }\n'
         'impedance = { name = "impedance_abs_n_s_m", unit = "N.s/m" }\n'

@@ -128,6 +128,28 @@ def semilogy_curves(path, curves: list[tuple[str, np.ndarray, np.ndarray, str]],
     return _save(fig, path)
 
 
+def impedance_curves(out_dir, test, models: dict, title: str) -> list[pathlib.Path]:
+    """impedance_abs.png and impedance_phase.png in out_dir: a damper test (pyfit.io.impedance.ImpedanceTest,
+    dots) and model impedances {legend: Z [N·s/m] of the test's shape} at every clamp-velocity level."""
+    out_dir = pathlib.Path(out_dir)
+    v = 2 * np.pi * test.frequencies[:, None] * test.amplitudes
+    styles = ["-", "--", ":", "-."]
+    curves_abs, curves_phase = [], []
+    for j in range(test.amplitudes.shape[1]):
+        level = f"{np.median(v[:, j]) * 1e3:.3g} mm/s"
+        colour = f"C{j % 10}"  # one colour per level, one line style per model
+        measured = test.impedance[:, j]
+        curves_abs.append((f"measured {level}", test.frequencies, np.abs(measured), colour + "o"))
+        curves_phase.append((f"measured {level}", test.frequencies, np.degrees(np.angle(measured)), colour + "o"))
+        for (legend, z), style in zip(models.items(), styles):
+            curves_abs.append((f"{legend} {level}", test.frequencies, np.abs(z[:, j]), colour + style))
+            curves_phase.append((f"{legend} {level}", test.frequencies, np.degrees(np.angle(z[:, j])), colour + style))
+    return [semilogy_curves(out_dir / "impedance_abs.png", curves_abs, "frequency [Hz]", "|Z| [N·s/m]",
+                            f"{title}: clamp impedance"),
+            semilogy_curves(out_dir / "impedance_phase.png", curves_phase, "frequency [Hz]", "phase of Z [deg]",
+                            f"{title}: clamp impedance phase", log=False)]
+
+
 def heat_map(path, values: np.ndarray, columns: list[str], rows: list[str], row_label: str,
              title: str) -> pathlib.Path:
     """A matrix (rows x columns) as colours with a colour bar."""

@@ -26,6 +26,11 @@ RESULTS = {
                                        "python scripts/diagnose.py --make-datasets results/gap_cases && "
                                        "python scripts/diagnose.py --cases results/gap_cases --out "
                                        "results/diagnose_cases"),
+    "docs/results/diagnose_cases_damper.md": ("results/diagnose_cases_damper/summary.md",
+                                              "python scripts/diagnose.py --model damper --make-datasets "
+                                              "results/gap_cases_damper --seeds 0 && python scripts/diagnose.py "
+                                              "--model damper --cases results/gap_cases_damper --out "
+                                              "results/diagnose_cases_damper"),
     "docs/results/diagnose_benchmark.md": ("results/diagnose_benchmark/report.md",
                                            "python scripts/diagnose.py --benchmark --config "
                                            "configs/diagnose_benchmark.toml --out results/diagnose_benchmark"),
@@ -54,6 +59,11 @@ RESULTS = {
                                                 "acc_x2 --motion a --seeds 0 && python scripts/diagnose.py --model "
                                                 "damper --cases results/lab_cases_design_acc --out "
                                                 "results/diagnose_lab_design_acc"),
+    "docs/results/diagnose_impedance.md": ("results/diagnose_impedance/summary.md",
+                                           "python scripts/diagnose.py --model damper --make-datasets "
+                                           "results/impedance_cases --excitation impedance --seeds 0 && "
+                                           "python scripts/diagnose.py --model damper --cases results/impedance_cases "
+                                           "--out results/diagnose_impedance"),
     "docs/results/boucwen_benchmark.md": ("results/boucwen_benchmark/summary.md",
                                           "python scripts/fit.py configs/boucwen_benchmark.toml --repeats 2 "
                                           "--out results/boucwen_benchmark"),
