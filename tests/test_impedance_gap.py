@@ -11,6 +11,7 @@ import pytest
 
 from pyfit.gap.datasets import DAMPER, IMPEDANCE_UNCERTAINTY, write_impedance_case
 from pyfit.gap.diagnose import DiagnoseConfig, DiagnoseError
+from pyfit.gap import impedance_gap
 from pyfit.gap.impedance_gap import diagnose_impedance
 from pyfit.io.impedance import read_impedance, write_impedance
 
@@ -24,6 +25,15 @@ def _diagnose_cli(test: pathlib.Path, out: pathlib.Path, fmu_dir, *extra) -> sub
                           timeout=1200)
 
 
+def _rerun_from_stored_fits(monkeypatch, *args, **kwargs) -> dict:
+    """The diagnosis again into the same folder with every fit forbidden: it must come from OUT/fits/."""
+    def no_fit(*_):
+        raise AssertionError("a fit was redone although it was stored")
+
+    monkeypatch.setattr(impedance_gap, "_least_squares", no_fit)
+    return diagnose_impedance(*args, **kwargs)
+
+
 def test_sidecar_states_the_uncertainty_the_noise_stays_below(tmp_path):
     case = write_impedance_case(tmp_path / "none", "none")
     test = read_impedance(case / "impedance_test.csv")
@@ -34,7 +44,7 @@ def test_sidecar_states_the_uncertainty_the_noise_stays_below(tmp_path):
     assert 0.004 < noise < IMPEDANCE_UNCERTAINTY  # 0.5 % in |Z| and 0.3° in phase: about 0.0073
 
 
-def test_null_case_is_no_significant_gap(fmu_dir, tmp_path, measured):
+def test_null_case_is_no_significant_gap(fmu_dir, tmp_path, measured, monkeypatch):
     case = write_impedance_case(tmp_path / "damper_none", "none", seed=2)
     run = _diagnose_cli(case / "impedance_test.csv", tmp_path / "out", fmu_dir, "--workers", "1")
     assert run.returncode == 0, run.stderr[-3000:]
@@ -43,9 +53,11 @@ def test_null_case_is_no_significant_gap(fmu_dir, tmp_path, measured):
     measured("impedance diagnosis, null case: held-out misfit of the calibrated linear damper (RMS |Z/Z_meas − 1|)",
              rep["heldout_error_nominal"], 1.2 * IMPEDANCE_UNCERTAINTY)
     assert "no significant gap" in (tmp_path / "out" / "report.md").read_text()
+    again = _rerun_from_stored_fits(monkeypatch, case / "impedance_test.csv", tmp_path / "out", fmu_dir=fmu_dir)
+    assert again["heldout_error_nominal"] == rep["heldout_error_nominal"]
 
 
-def test_withheld_cubic_stiffness_is_named(fmu_dir, tmp_path, measured):
+def test_withheld_cubic_stiffness_is_named(fmu_dir, tmp_path, measured, monkeypatch):
     case = write_impedance_case(tmp_path / "damper_cubic", "cubic_stiffness")
     cfg = DiagnoseConfig(**{**SHORT.__dict__, "effects": ["cubic_stiffness", "quadratic_damping"]})
     rep = diagnose_impedance(case / "impedance_test.csv", tmp_path / "out", cfg, fmu_dir, workers=2)
@@ -59,6 +71,8 @@ def test_withheld_cubic_stiffness_is_named(fmu_dir, tmp_path, measured):
     for name in ("k_cs1", "k_cs2"):
         measured(f"impedance diagnosis: fitted {name} relative to the withheld value",
                  abs(top["params"][name] / truth[name] - 1), 0.05)
+    again = _rerun_from_stored_fits(monkeypatch, case / "impedance_test.csv", tmp_path / "out", cfg, fmu_dir)
+    assert again["ranking"] == rep["ranking"]
 
 
 def test_two_levels_cannot_be_diagnosed(tmp_path, fmu_dir):

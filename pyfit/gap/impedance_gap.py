@@ -11,6 +11,7 @@ harmonics over whole periods) of the DamperElement FMU. SI units.
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import pathlib
 from dataclasses import asdict, dataclass
@@ -84,9 +85,22 @@ def _least_squares(fmu: str, test: ImpedanceTest, fixed: dict, starts: list[dict
     return {**fixed, **unit.values(result.x)}, len(xs) + result.n_evaluations
 
 
-def _least_squares_task(args: tuple) -> tuple[dict, int]:
-    """_least_squares(*args), for a worker process."""
-    return _least_squares(*args)
+def _fit_and_store(job: tuple) -> tuple[dict, int]:
+    """_least_squares(*args) (in a worker), stored at once in `path` under `key`: an interrupted diagnosis
+    keeps it."""
+    args, path, key = job
+    params, evaluations = _least_squares(*args)
+    pathlib.Path(path).write_text(json.dumps({"key": key, "params": params, "evaluations": evaluations}, indent=1))
+    return params, evaluations
+
+
+def _stored(path: pathlib.Path, key: str) -> tuple[dict, int] | None:
+    """A fit stored by _fit_and_store under the same key (same test, nominal and fit settings), or None."""
+    if path.is_file():
+        d = json.loads(path.read_text())
+        if d.get("key") == key:
+            return d["params"], d["evaluations"]
+    return None
 
 
 def deflection_scale(fmu: str, test: ImpedanceTest, params: dict, settle: float = 4.0) -> Scale:
@@ -128,9 +142,9 @@ def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu
                        workers: int | None = None) -> dict:
     """Diagnose a damper's impedance test against the nominal damper (a NominalModel or TOML file; None: the
     design 1.3 damper); `uncertainty`: the test's relative measurement error (RMS of |Z_meas / Z_true − 1|;
-    None: the value its sidecar states);
-    the effects are refitted in parallel on `workers` processes (None: one per core). Writes OUT/report.json
-    and OUT/report.md; returns the report."""
+    None: the value its sidecar states). The effects are refitted in parallel on `workers` processes (None:
+    one per core); finished fits are kept in OUT/fits/ (a rerun with the same OUT redoes only the unfinished
+    ones). Writes OUT/report.json, OUT/report.md and the impedance figures; returns the report."""
     cfg = cfg or DiagnoseConfig()
     test = read_impedance(csv_path)
     uncertainty = test.uncertainty if uncertainty is None else uncertainty
@@ -164,7 +178,15 @@ def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu
     starts = [start] + [{**start, system.stiffness: start[system.stiffness] * f} for f in STIFFNESS_SCAN if f != 1]
     bounds = {n: (min(system.bounds(s)[n][0] for s in starts), max(system.bounds(s)[n][1] for s in starts))
               for n in start}
-    params, n_eval = _least_squares(fmu, cal, dict(system.nominal_fixed), starts, bounds, (), cfg.nominal_budget)
+    out = pathlib.Path(out_dir)
+    (out / "fits").mkdir(parents=True, exist_ok=True)
+    description = ({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}
+                   if described else {})
+    key = hashlib.sha256(test.path.read_bytes() + test.path.with_suffix(".toml").read_bytes() + json.dumps(
+        [cfg.nominal_budget, cfg.refit_budget, description], sort_keys=True).encode()).hexdigest()[:16]
+    nominal_path = out / "fits" / "nominal.json"
+    params, n_eval = _stored(nominal_path, key) or _fit_and_store(
+        ((fmu, cal, dict(system.nominal_fixed), starts, bounds, (), cfg.nominal_budget), nominal_path, key))
     nominal_fit = judged("nominal", params, list(start), 0, n_eval)
     floor, gap = uncertainty, nominal_fit.heldout_error
     significant = gap > max(cfg.noise_factor * floor, floor + cfg.min_gap)
@@ -172,17 +194,20 @@ def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu
     fits = {}
     if significant and nominal_fits:
         scale = deflection_scale(fmu, cal, {**defaults, **nominal_fit.params})
-        names = cfg.effects or list(system.effects)
-        tasks = []
-        for name in names:
-            effect = system.effects[name]
+        free, jobs = {}, []
+        for name in cfg.effects or list(system.effects):
+            effect, path = system.effects[name], out / "fits" / f"{name}.json"
             e_start, e_bounds, e_fixed = effect_start(system, effect, scale, nominal_fit.params)
+            free[name], stored = list(e_start), _stored(path, key)
+            if stored:
+                fits[name] = judged(name, stored[0], free[name], len(effect.params), stored[1])
+                continue
             tries = [{**e_start, **s} for s in _strength_starts(effect, scale)]
-            tasks.append((fmu, cal, {**system.nominal_fixed, **e_fixed}, tries, e_bounds,
-                          tuple(p.name for p in effect.params if p.shape), cfg.refit_budget))
-        for name, task, (params, n_eval) in zip(names, tasks, map_tasks(_least_squares_task, tasks, workers,
-                                                                         progress=False)):
-            fits[name] = judged(name, params, list(task[3][0]), len(system.effects[name].params), n_eval)
+            jobs.append(((fmu, cal, {**system.nominal_fixed, **e_fixed}, tries, e_bounds,
+                          tuple(p.name for p in effect.params if p.shape), cfg.refit_budget), path, key))
+        for job, (params, n_eval) in zip(jobs, map_tasks(_fit_and_store, jobs, workers, progress=False)):
+            name = job[1].stem
+            fits[name] = judged(name, params, free[name], len(system.effects[name].params), n_eval)
     ranking = []
     # the reference of the shrink: the stated uncertainty, or the best held-out misfit if smaller
     reference = min([floor] + [fit.heldout_error for fit in fits.values()])
@@ -216,8 +241,6 @@ def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu
               "by_frequency": [{"frequency_hz": float(f), "heldout_error": float(e)}
                                for f, e in zip(test.frequencies, by_frequency)],
               "ranking": ranking}
-    out = pathlib.Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     models = {"nominal": z_nom}
     if ranking:
         best = ranking[0]["effect"]
