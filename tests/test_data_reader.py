@@ -1,4 +1,6 @@
 """The measurement reader on files written the way lab software writes them (not by our writer)."""
+import pathlib
+
 import numpy as np
 import pytest
 
@@ -131,3 +133,52 @@ def test_levels_ordered_by_value_then_excitation_then_input_rms(tmp_path):
                                                     + r.split(",")[3:]) for r in text[3:] if r] ) + "\n")
     items, basis = read_dataset_with_order(d)
     assert basis == "input RMS" and [m.path.stem for m in items] == ["f1", "f0", "f2"]
+
+
+def _export(tmp_path, header: str, rows: list[str], unit_x: str = "mm") -> pathlib.Path:
+    """A CSV written by hand (header, then rows) with a sidecar for its columns "x" (unit_x) and "F" (kN)."""
+    path = tmp_path / "export.csv"
+    path.write_text("\n".join([header] + rows) + "\n")
+    path.with_suffix(".toml").write_text("\n".join([
+        'model = "SDOFBoucWen"', f"sample_rate_hz = {FS}", 'time_column = "Time, s"', "[inputs]",
+        'F = { unit = "kN", model_variable = "u" }', "[outputs]", f'x = {{ unit = "{unit_x}", model_variable = "y" }}']))
+    return path
+
+
+ROWS = [f"{k / FS:.6g},{0.5 * k:.6f},{-2.0 * k:.6f}" for k in range(400)]
+
+
+@pytest.mark.parametrize("header, rows, unit_x", [
+    ('"Time, s",x,F', ROWS, "mm"),  # a comma inside a quoted name
+    ('"Time, s",x,F\n"s","mm","kN"', ROWS, "mm"),  # a units row that agrees with the sidecar
+    ('"Time, s",x,F\n\n# units:\ns,mm,kN\n# data:', ROWS, "mm"),  # blank and comment lines around the units row
+    ('"Time, s",x,F\n[s],[mm],[kN]', ROWS, "[mm]"),  # bracketed units, in the row and in the sidecar
+    ('"Time, s",x,F,', [r + "," for r in ROWS], "mm"),  # every line ends in the delimiter
+    ('"Time, s",x,F', ['"{}","{}","{}"'.format(*r.split(",")) for r in ROWS], "mm"),  # quoted numbers
+])
+def test_lab_export_variants_are_read(tmp_path, header, rows, unit_x):
+    m = read_measurement(_export(tmp_path, header, rows, unit_x))
+    k = np.arange(400)
+    assert np.array_equal(m.values["x"], 0.5e-3 * k) and np.array_equal(m.values["F"], -2.0e3 * k)  # mm, kN -> SI
+    assert np.max(np.abs(m.t - k / FS)) < 1e-8  # the grid fitted to stamps rounded by up to 5e-7 s
+
+
+@pytest.mark.parametrize("unit, si", [("m/s^2", 1.0), ("m/s²", 1.0), ("mm/s^2", 1e-3), ("µm", 1e-6), ("μm", 1e-6),
+                                      ("[m/s]", 1.0)])
+def test_unit_spellings(tmp_path, unit, si):
+    m = read_measurement(_export(tmp_path, '"Time, s",x,F', ROWS, unit))
+    assert m.values["x"][2] == pytest.approx(1.0 * si, rel=1e-15)
+
+
+def test_units_row_that_contradicts_the_sidecar_is_refused(tmp_path):
+    p = _export(tmp_path, '"Time, s",x,F\ns,m,kN', ROWS)
+    with pytest.raises(MeasurementError, match=r"export.csv: row 2: the units row gives 'm' for column 'x' but "
+                                               r"export.toml says 'mm'; allowed: the same unit in both"):
+        read_measurement(p)
+
+
+def test_space_separated_export_names_the_fix(tmp_path):
+    p = _export(tmp_path, "t x F", [r.replace(",", " ") for r in ROWS])
+    with pytest.raises(MeasurementError, match=r"export.csv: row 1: columns are separated by spaces; allowed: ',' "
+                                               r"or a tab"):
+        read_measurement(p)

@@ -79,7 +79,8 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> R
     # at most a quarter of a short record is given up to the start-up transient
     first = 0 if spp or starts_at_rest(m) else min(int(round(transient_s * m.sample_rate_hz)), n // 4)
     outputs = {k: v[first:] for k, v in m.by_variable("outputs").items()}
-    return Record(m.path.stem, m.level, float(m.level_value if m.level_value is not None else 0.0),
+    # a file without a `level` label is named by its file in every table and figure
+    return Record(m.path.stem, m.level or m.path.stem, float(m.level_value if m.level_value is not None else 0.0),
                   m.sample_rate_hz, inputs, outputs, spp, weights, derived, first)
 
 

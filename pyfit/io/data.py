@@ -4,17 +4,22 @@ Sidecar keys: model, sample_rate_hz, [inputs] and [outputs] mapping column -> {u
 optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s" or "ms").
 
 The reader takes files as lab software writes them, wherever that is still unambiguous:
-- `#` comment lines before the header, quoted column names, ',' or tab between columns, extra columns
-  (never parsed);
+- `#` comment lines before the header, quoted column names (commas inside quotes included) and quoted
+  numbers, ',' or tab between columns, a trailing delimiter, extra columns (never parsed);
+- a units row under the header (every field non-numeric, e.g. `s,mm,kN`): skipped; where it names a known
+  unit for a used column, that unit must be the sidecar's;
+- unit spellings: `[mm]`, `m/s^2`, `m/s²`, `µm`, `μm` are the same as mm, m/s2, um;
 - a time column rounded to as few as 6 significant digits, or none at all (then sample_rate_hz gives the
   time); the samples are put on the exact grid t0 + k/fs;
 - units converted to SI on reading (see TO_SI).
 and refuses, with one error naming file, row and value, what is not: a gap, a repeated or decreasing
 time, a time column that disagrees with sample_rate_hz by more than MAX_TIME_SLIP samples, `;`
-separators or decimal commas, non-numeric or non-finite values in a used column.
+separators or decimal commas, columns separated by spaces, a units row that contradicts the sidecar,
+non-numeric or non-finite values in a used column.
 """
 from __future__ import annotations
 
+import csv
 import pathlib
 from dataclasses import dataclass, field
 
@@ -22,15 +27,23 @@ import numpy as np
 
 from pyfit.io.schema import ConfigError, check_table, fail, read_toml
 
-TO_SI = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "rad": 1.0, "deg": np.pi / 180, "m/s": 1.0,
-         "mm/s": 1e-3, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0, "mm/s2": 1e-3, "g": 9.80665, "N": 1.0,
-         "kN": 1e3}
+TO_SI = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "rad": 1.0, "deg": np.pi / 180, "m/s": 1.0, "mm/s": 1e-3,
+         "m/s2": 1.0, "mm/s2": 1e-3, "g": 9.80665, "N": 1.0, "kN": 1e3}
 TIME_UNITS = {"s": 1.0, "ms": 1e-3}
 MAX_TIME_SLIP = 0.25  # largest allowed distance [samples] of a time stamp from the uniform grid
 SIDECAR = {"model": (str, True, None), "sample_rate_hz": ("number", True, None), "inputs": (dict, False, {}),
            "outputs": (dict, True, None), "level": (str, False, ""), "level_value": ("number", False, None),
            "excitation": (dict, False, {}), "notes": (str, False, ""), "time_column": (str, False, "t"),
            "time_unit": (str, False, "s")}
+
+
+def unit_key(unit: str) -> str:
+    """A unit as TO_SI spells it: brackets and spaces dropped, '^2', '**2' and '²' as '2', 'µ'/'μ' as 'u'
+    ('[m/s^2]' -> 'm/s2'); an unknown unit is returned as it is (after the same clean-up)."""
+    u = unit.strip().strip("[]()").replace(" ", "")
+    for a, b in (("**2", "2"), ("^2", "2"), ("²", "2"), ("µ", "u"), ("μ", "u")):
+        u = u.replace(a, b)
+    return u
 
 
 class MeasurementError(ConfigError):
@@ -76,6 +89,7 @@ def _channels(side, table, section) -> dict[str, Channel]:
     for col, spec in table.items():
         c = check_table(spec, side, f"{section}.{col}", {"unit": (str, True, None), "model_variable": (str, True, None),
                                                          "weight": ("number", False, 1.0)}, MeasurementError)
+        c["unit"] = unit_key(c["unit"])
         if c["unit"] not in TO_SI:
             fail(side, f"{section}.{col}.unit", f"'{c['unit']}' unknown", ", ".join(TO_SI), MeasurementError)
         if c["weight"] <= 0:
@@ -84,34 +98,72 @@ def _channels(side, table, section) -> dict[str, Channel]:
     return out
 
 
-def _header(csv_path: pathlib.Path) -> tuple[list[str], int, str]:
-    """Column names, the number of lines before the data (comment lines and the header) and the delimiter
-    (',' or a tab)."""
+def _fields(line: str, delimiter: str) -> list[str]:
+    """The fields of one CSV line (quotes removed, a comma inside quotes kept), stripped; a trailing empty
+    field (a line that ends in the delimiter) dropped."""
+    fields = [f.strip() for f in next(csv.reader([line.strip()], delimiter=delimiter, skipinitialspace=True))]
+    return fields[:-1] if len(fields) > 1 and fields[-1] == "" else fields
+
+
+def _numeric(field: str) -> bool:
+    try:
+        float(field)
+        return True
+    except ValueError:
+        return False
+
+
+@dataclass
+class _Header:
+    """Column names, the number of lines before the data (comments, header, units row), the delimiter, and
+    the units row (column -> unit as written; {} if the file has none)."""
+
+    names: list[str]
+    skip: int
+    delimiter: str
+    units: dict[str, str]
+
+
+def _header(csv_path: pathlib.Path) -> _Header:
+    """Read the lines before the data: '#' comments, the header, and a units row if there is one."""
     with open(csv_path, encoding="utf-8-sig") as f:
         for skip, line in enumerate(f, 1):
             if line.strip() and not line.lstrip().startswith("#"):
                 break
         else:
             raise MeasurementError(f"{csv_path}: no header line (only comments or empty)")
-        first = next((ln for ln in f if ln.strip() and not ln.lstrip().startswith("#")), "")
+        rest = []  # the next two lines with content, and their line numbers
+        for number, ln in enumerate(f, skip + 1):
+            if ln.strip() and not ln.lstrip().startswith("#"):
+                rest.append((number, ln))
+                if len(rest) == 2:
+                    break
     delimiter = "," if "," in line or "\t" not in line else "\t"
     if ";" in line and delimiter not in line:
         raise MeasurementError(f"{csv_path}: row {skip}: columns are separated by ';' (a decimal-comma export); "
                                "allowed: ',' between columns and '.' as the decimal mark (export as CSV with a "
                                "point decimal separator)")
-    names = [h.strip().strip('"').strip("'") for h in line.strip().split(delimiter)]
-    fields = len(first.strip().split(delimiter))
-    if first.strip() and fields != len(names):
+    names = _fields(line, delimiter)
+    first = rest[0][1] if rest else ""
+    if len(names) == 1 and len(first.split()) > 1 and delimiter not in first:
+        raise MeasurementError(f"{csv_path}: row {skip}: columns are separated by spaces; allowed: ',' or a tab "
+                               "between columns (export as CSV)")
+    units = {}
+    if first.strip() and not any(_numeric(v) for v in _fields(first, delimiter)):
+        units = dict(zip(names, _fields(first, delimiter)))  # a units row under the header
+        skip, first = rest[0][0], rest[1][1] if len(rest) > 1 else ""
+    fields = len(_fields(first, delimiter)) if first.strip() else len(names)
+    if fields != len(names):
         hint = " (decimal commas? use '.' as the decimal mark)" if fields > len(names) else ""
         raise MeasurementError(f"{csv_path}: row {skip + 1}: {fields} fields but {len(names)} column names{hint}")
-    return names, skip, delimiter
+    return _Header(names, skip, delimiter, units)
 
 
-def _load_columns(csv_path, names, skip, delimiter, wanted: list[str]) -> dict[str, np.ndarray]:
-    idx = [names.index(w) for w in wanted]
+def _load_columns(csv_path, head: _Header, wanted: list[str]) -> dict[str, np.ndarray]:
+    idx = [head.names.index(w) for w in wanted]
     try:
-        data = np.loadtxt(csv_path, delimiter=delimiter, skiprows=skip, usecols=idx, ndmin=2, comments="#",
-                          encoding="utf-8-sig")
+        data = np.loadtxt(csv_path, delimiter=head.delimiter, skiprows=head.skip, usecols=idx, ndmin=2,
+                          comments="#", quotechar='"', encoding="utf-8-sig")
     except ValueError as exc:
         raise MeasurementError(f"{csv_path}: not numeric in a used column ({', '.join(wanted)}): {exc}; "
                                "allowed: numbers with '.' as the decimal mark") from exc
@@ -123,11 +175,11 @@ def read_csv_columns(csv_path, wanted: list[str]) -> dict[str, np.ndarray]:
     csv_path = pathlib.Path(csv_path)
     if not csv_path.is_file():
         raise MeasurementError(f"{csv_path}: file not found")
-    names, skip, delimiter = _header(csv_path)
+    head = _header(csv_path)
     for w in wanted:
-        if w not in names:
-            raise MeasurementError(f"{csv_path}: no column {w!r}; columns: {', '.join(names)}")
-    return _load_columns(csv_path, names, skip, delimiter, wanted)
+        if w not in head.names:
+            raise MeasurementError(f"{csv_path}: no column {w!r}; columns: {', '.join(head.names)}")
+    return _load_columns(csv_path, head, wanted)
 
 
 def check_time(t: np.ndarray, fs: float, csv_path, side, column: str, first_row: int) -> None:
@@ -174,13 +226,18 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
         fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join(TIME_UNITS), MeasurementError)
     inputs = _channels(side, meta["inputs"], "inputs")
     outputs = _channels(side, meta["outputs"], "outputs")
-    names, skip, delimiter = _header(csv_path)
-    for name in list(inputs) + list(outputs):
+    head = _header(csv_path)
+    names, skip = head.names, head.skip
+    for name, ch in {**inputs, **outputs}.items():
         if name not in names:
             raise MeasurementError(f"{csv_path}: column '{name}' named in {side.name} is missing; "
                                    f"columns: {', '.join(names)}")
+        written = unit_key(head.units.get(name, ""))
+        if written in TO_SI and written != ch.unit:
+            raise MeasurementError(f"{csv_path}: row {skip}: the units row gives '{head.units[name]}' for column "
+                                   f"'{name}' but {side.name} says '{ch.unit}'; allowed: the same unit in both")
     time_col = meta["time_column"] if meta["time_column"] in names else None
-    cols = _load_columns(csv_path, names, skip, delimiter, ([time_col] if time_col else []) + list({**inputs, **outputs}))
+    cols = _load_columns(csv_path, head, ([time_col] if time_col else []) + list({**inputs, **outputs}))
     n = len(next(iter(cols.values())))
     if time_col:
         t_file = cols.pop(time_col) * TIME_UNITS[meta["time_unit"]]
@@ -217,7 +274,7 @@ def write_measurement(csv_path: str | pathlib.Path, model: str, t: np.ndarray, i
     csv_path.parent.mkdir(parents=True, exist_ok=True)
     fs = (len(t) - 1) / (t[-1] - t[0])
     cols = {**inputs, **outputs}
-    data = np.column_stack([t] + [np.asarray(v[0]) / TO_SI[v[1]] for v in cols.values()])
+    data = np.column_stack([t] + [np.asarray(v[0]) / TO_SI[unit_key(v[1])] for v in cols.values()])
     np.savetxt(csv_path, data, delimiter=",", header=",".join(["t"] + list(cols)), comments="",
                fmt=["%.12g"] + ["%.10g"] * len(cols))
 
@@ -282,5 +339,5 @@ def read_dataset_with_order(folder: str | pathlib.Path) -> tuple[list[Measuremen
     return level_order(items)
 
 
-__all__ = ["Channel", "Measurement", "MeasurementError", "TO_SI", "level_order", "read_dataset",
+__all__ = ["Channel", "Measurement", "MeasurementError", "TO_SI", "level_order", "read_dataset", "unit_key",
            "read_dataset_with_order", "read_measurement", "write_measurement"]
