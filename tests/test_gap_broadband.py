@@ -58,6 +58,8 @@ def test_broadband_segments_of_a_duffing_oscillator_are_diagnosed_as_cubic_stiff
     rep = dg.diagnose("sdof", duffing_dataset, tmp_path / "out", fmu_dir=fmu_dir, workers=2, progress=False)
     assert rep["verdict"] == "gap explained by cubic_stiffness"
     assert rep["gap"]["noise_floor_method"] == ["local polynomial, lowest level"]
+    assert rep["level_order"] == "input RMS"  # the sidecars give labels only: the segments order by their RMS
+    assert "Levels ordered by input RMS." in (tmp_path / "out" / "report.md").read_text()
     best = rep["ranking"][0]
     measured("Duffing broadband segments (independent solver, DAQ-style files): held-out shrink [%]",
              best["shrink_pct"], 80.0, at_least=True)

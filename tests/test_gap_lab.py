@@ -55,3 +55,57 @@ def test_design_damper_sweeps_recorded_by_accelerometers(tmp_path, fmu_dir, effe
     rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
     _check(rep, effect, measured, "design damper, constant-velocity clamp sweeps, accelerometers on the clamp "
                                   "and on both masses")
+
+
+def _foreign_export(src: pathlib.Path, dst: pathlib.Path) -> pathlib.Path:
+    """The dataset in src rewritten as another bench's software exports it: CRLF line ends, a comment line,
+    quoted column names with commas in them, a units row, time in ms (6 significant digits), mm / kN / g, a
+    text column, no level_value (the levels order by the sidecar's excitation amplitude), and the last file
+    without a time column (its rate from the sidecar)."""
+    import tomllib
+
+    from pyfit.io.data import read_measurement
+
+    unit = {"x_base": ("mm", 1e3), "F_clamp": ("kN", 1e-3), "acc_x1": ("g", 1 / 9.80665)}
+    dst.mkdir(parents=True)
+    files = sorted(src.glob("*.csv"))
+    for i, path in enumerate(files):
+        m, side = read_measurement(path), tomllib.loads(path.with_suffix(".toml").read_text())
+        timed = i < len(files) - 1
+        names, units, cols = (["Time, ms"], ["ms"], [[f"{v:.6g}" for v in m.t * 1e3]]) if timed else ([], [], [])
+        tables = {"inputs": [], "outputs": []}
+        for kind in tables:
+            for column, ch in getattr(m, kind).items():
+                u, factor = unit[ch.model_variable]
+                names.append(f"{ch.model_variable}, {u}")
+                units.append(u)
+                cols.append([f"{v:.7g}" for v in m.values[column] * factor])
+                tables[kind].append(f'"{names[-1]}" = {{ unit = "{u}", model_variable = "{ch.model_variable}" }}')
+        lines = ["# Bench export v3.2", ",".join(f'"{n}"' for n in names + ["Status"]), ",".join(units + ["-"])]
+        lines += [",".join(row + ("OK",)) for row in zip(*cols)]
+        (dst / path.name).write_bytes(("\r\n".join(lines) + "\r\n").encode())
+        exc = "\n".join(f"{k} = {v!r}".replace("'", '"') for k, v in side["excitation"].items())
+        (dst / path.with_suffix(".toml").name).write_text("\n".join(
+            [f'model = "{side["model"]}"', f'sample_rate_hz = {side["sample_rate_hz"]}', f'level = "{side["level"]}"']
+            + (['time_column = "Time, ms"', 'time_unit = "ms"'] if timed else [])
+            + ["[inputs]"] + tables["inputs"] + ["[outputs]"] + tables["outputs"] + ["[excitation]", exc]) + "\n")
+    return dst
+
+
+@pytest.mark.slow
+def test_design_damper_from_another_benchs_export_with_load_cell_and_accelerometer(tmp_path, measured):
+    """Coulomb friction withheld; clamp displacement only, the clamp force from the load cells and one
+    accelerometer on mass 1, in files written by another bench's software (see _foreign_export)."""
+    import json
+
+    ours = datasets.write_dataset(tmp_path / "ours", datasets.DAMPER, "coulomb_friction",
+                                  style=datasets.LabStyle("sweep", outputs=("F_clamp", "acc_x1"), motion="x"))
+    data = _foreign_export(ours, tmp_path / "export")
+    rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(), workers=2, progress=False)
+    assert rep["level_order"] == "excitation.amplitude"
+    _check(rep, "coulomb_friction", measured, "design damper, another bench's export (load cell, accelerometer, "
+                                              "clamp displacement only)")
+    truth = json.loads((ours / "truth.json").read_text())["params"]
+    for name in ("F_c1", "F_c2"):
+        measured(f"the same: fitted {name} relative to the withheld value",
+                 abs(rep["ranking"][0]["params"][name] / truth[name] - 1), 0.05)

@@ -12,7 +12,7 @@ from dataclasses import asdict, dataclass, fields
 
 from pyfit.runtime.batch import map_tasks
 from pyfit.runtime.clock import StageClock
-from pyfit.io.data import MeasurementError, read_dataset
+from pyfit.io.data import MeasurementError, read_dataset_with_order
 from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
 from pyfit.runtime.examples import ensure_fmu
@@ -66,14 +66,15 @@ def load_config(path) -> DiagnoseConfig:
 
 
 def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
-    """Records of the dataset, validated against the FMU's variables, split into calibration and held-out."""
+    """Records of the dataset, validated against the FMU's variables, split into calibration and held-out; the
+    data's digest and what the level order rests on (pyfit.io.data.level_order)."""
     data_dir = pathlib.Path(data_dir)
     md_vars = runner.model_description.modelVariables
     variables = {v.name for v in md_vars}
     allowed = {"inputs": [v.name for v in md_vars if v.causality == "input"],
                "outputs": [v.name for v in md_vars if v.causality == "output"]}
     try:
-        ms = read_dataset(data_dir)
+        ms, order = read_dataset_with_order(data_dir)
     except MeasurementError as exc:
         raise DiagnoseError(str(exc)) from exc
     missing = [p.name for p in sorted(data_dir.glob("*.csv")) if not p.with_suffix(".toml").is_file()]
@@ -120,7 +121,7 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
     for m in ms:
         digest.update(m.path.read_bytes())
         digest.update(m.path.with_suffix(".toml").read_bytes())
-    return records, cal, held, digest.hexdigest()[:16]
+    return records, cal, held, digest.hexdigest()[:16], order
 
 
 def _fit_and_store(job) -> Fit:
@@ -167,7 +168,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
                                 f"of '{model}'")
         described.check_names(set(runner.parameter_names()))
     system = make_system(model, fmu_defaults(runner), described)
-    records, cal, held, data_key = _load(data_dir, system, cfg, runner)
+    records, cal, held, data_key, level_order = _load(data_dir, system, cfg, runner)
     lo, hi = localise.excited_range(records)
     modes = linear_modes(fmu, {**system.nominal_fixed, **system.start(cal)})
     if modes and not any(lo <= m.f_n <= hi for m in modes):
@@ -235,6 +236,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
                           for r in held}
         clock.end("refits with each effect")
     result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap)
+    result["level_order"] = level_order
     result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample, system.lead_periods)
     runner.close()
     clock.end("verdict")

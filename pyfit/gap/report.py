@@ -205,7 +205,8 @@ def markdown(result: dict) -> str:
     lines = [f"# Gap diagnosis: {result['model']} ({result['fmu']})", "",
              f"**Verdict: {result['verdict']}.**", "",
              f"Calibrated on {', '.join(result['calibration_files'])}; held out: "
-             f"{', '.join(result['held_out_files'])}.", "",
+             f"{', '.join(result['held_out_files'])}. Levels ordered by {result['level_order']}.",
+             "",
              f"Held-out gap (NRMSE) of the nominal model: **{g['overall']:.4f}**; noise floor from the data: "
              f"{g['noise_floor']:.4f} ({', '.join(g.get('noise_floor_method', []))}); nominal calibration NRMSE "
              f"{result['nominal']['calibration_nrmse']:.4f}. An effect explains the gap when the held-out NRMSE with "
