@@ -93,7 +93,7 @@ def _foreign_export(src: pathlib.Path, dst: pathlib.Path) -> pathlib.Path:
 
 
 @pytest.mark.slow
-def test_design_damper_from_another_benchs_export_with_load_cell_and_accelerometer(tmp_path, measured):
+def test_design_damper_from_another_benchs_export_with_load_cell_and_accelerometer(tmp_path, fmu_dir, measured):
     """Coulomb friction withheld; clamp displacement only, the clamp force from the load cells and one
     accelerometer on mass 1, in files written by another bench's software (see _foreign_export)."""
     import json
@@ -101,7 +101,7 @@ def test_design_damper_from_another_benchs_export_with_load_cell_and_acceleromet
     ours = datasets.write_dataset(tmp_path / "ours", datasets.DAMPER, "coulomb_friction",
                                   style=datasets.LabStyle("sweep", outputs=("F_clamp", "acc_x1"), motion="x"))
     data = _foreign_export(ours, tmp_path / "export")
-    rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(), workers=2, progress=False)
+    rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
     assert rep["level_order"] == "excitation.amplitude"
     _check(rep, "coulomb_friction", measured, "design damper, another bench's export (load cell, accelerometer, "
                                               "clamp displacement only)")
