@@ -175,6 +175,10 @@ def test_units_row_that_contradicts_the_sidecar_is_refused(tmp_path):
     with pytest.raises(MeasurementError, match=r"export.csv: row 2: the units row gives 'm' for column 'x' but "
                                                r"export.toml says 'mm'; allowed: the same unit in both"):
         read_measurement(p)
+    p = _export(tmp_path, '"Time, s",x,F\nms,mm,kN', ROWS)  # the sidecar's time_unit is the default "s"
+    with pytest.raises(MeasurementError, match=r"row 2: the units row gives 'ms' for the time column 'Time, s' "
+                                               r"but export.toml says time_unit = 's'"):
+        read_measurement(p)
 
 
 def test_space_separated_export_names_the_fix(tmp_path):

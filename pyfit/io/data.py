@@ -7,7 +7,7 @@ The reader takes files as lab software writes them, wherever that is still unamb
 - `#` comment lines before the header, quoted column names (commas inside quotes included) and quoted
   numbers, ',' or tab between columns, a trailing delimiter, extra columns (never parsed);
 - a units row under the header (every field non-numeric, e.g. `s,mm,kN`): skipped; where it names a known
-  unit for a used column, that unit must be the sidecar's;
+  unit for a used column or the time column, that unit must be the sidecar's;
 - unit spellings: `[mm]`, `m/s^2`, `m/s²`, `µm`, `μm` are the same as mm, m/s2, um;
 - a time column rounded to as few as 6 significant digits, or none at all (then sample_rate_hz gives the
   time); the samples are put on the exact grid t0 + k/fs;
@@ -237,6 +237,11 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
             raise MeasurementError(f"{csv_path}: row {skip}: the units row gives '{head.units[name]}' for column "
                                    f"'{name}' but {side.name} says '{ch.unit}'; allowed: the same unit in both")
     time_col = meta["time_column"] if meta["time_column"] in names else None
+    written = unit_key(head.units.get(time_col, ""))
+    if written in TIME_UNITS and written != meta["time_unit"]:
+        raise MeasurementError(f"{csv_path}: row {skip}: the units row gives '{head.units[time_col]}' for the time "
+                               f"column '{time_col}' but {side.name} says time_unit = '{meta['time_unit']}'; "
+                               "allowed: the same unit in both")
     cols = _load_columns(csv_path, head, ([time_col] if time_col else []) + list({**inputs, **outputs}))
     n = len(next(iter(cols.values())))
     if time_col:
