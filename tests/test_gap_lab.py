@@ -60,13 +60,17 @@ def test_design_damper_sweeps_recorded_by_accelerometers(tmp_path, fmu_dir, effe
 def _foreign_export(src: pathlib.Path, dst: pathlib.Path) -> pathlib.Path:
     """The dataset in src rewritten as another bench's software exports it: CRLF line ends, a comment line,
     quoted column names with commas in them, a units row, time in ms (6 significant digits), mm / kN / g, a
-    text column, no level_value (the levels order by the sidecar's excitation amplitude), and the last file
-    without a time column (its rate from the sidecar)."""
+    text column, no level_value (the levels order by the sidecar's excitation amplitude), the last file
+    without a time column (its rate from the sidecar), and the sensors' zeros: the load cell carries the
+    damper's weight, the accelerometer is DC-coupled (1 g), the clamp's displacement sensor reads 2 mm at
+    rest."""
     import tomllib
 
     from pyfit.io.data import read_measurement
 
     unit = {"x_base": ("mm", 1e3), "F_clamp": ("kN", 1e-3), "acc_x1": ("g", 1 / 9.80665)}
+    weight = 9.80665 * (0.8 + 0.6 + 0.6 + 0.3 * (0.17 + 0.12))  # N: m1 + m2 + m_c + mu (L1 + L2), design 1.3
+    zero = {"x_base": 2e-3, "F_clamp": weight, "acc_x1": 9.80665}  # SI
     dst.mkdir(parents=True)
     files = sorted(src.glob("*.csv"))
     for i, path in enumerate(files):
@@ -79,7 +83,7 @@ def _foreign_export(src: pathlib.Path, dst: pathlib.Path) -> pathlib.Path:
                 u, factor = unit[ch.model_variable]
                 names.append(f"{ch.model_variable}, {u}")
                 units.append(u)
-                cols.append([f"{v:.7g}" for v in m.values[column] * factor])
+                cols.append([f"{v:.7g}" for v in (m.values[column] + zero[ch.model_variable]) * factor])
                 tables[kind].append(f'"{names[-1]}" = {{ unit = "{u}", model_variable = "{ch.model_variable}" }}')
         lines = ["# Bench export v3.2", ",".join(f'"{n}"' for n in names + ["Status"]), ",".join(units + ["-"])]
         lines += [",".join(row + ("OK",)) for row in zip(*cols)]

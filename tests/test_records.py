@@ -56,3 +56,43 @@ def test_a_channel_that_is_not_an_fmu_variable_is_refused(tmp_path, fmu_dir):
     with pytest.raises(DiagnoseError, match=r"l0.toml: \[outputs\] model_variable 'y_mass' is not a variable of "
                                             r"SDOFBoucWen; allowed: F, a, v, y, z"):
         diagnose("sdof", tmp_path, tmp_path / "out", fmu_dir=fmu_dir, progress=False)
+
+
+def test_sensor_offsets_are_not_dynamics(tmp_path, runner, measured):
+    """A displacement transducer's rest reading (5 mm, some 30 × the vibration), a DC accelerometer's 1 g and a
+    load cell's zero (20 N, some 15 × the force RMS) change neither the records the diagnosis simulates and
+    compares nor the residual of the true model, nor whether the record counts as starting at rest."""
+    fs = 500.0
+    exc = Excitation(2, 50.0, 20.0, 50.0, 1.5)
+    t, y, u = simulate_truth(SyntheticSpec("SDOFBoucWen", exc, 8.0, fs, ["y", "a"], TRUTH, oversample=10,
+                                           passband_ripple_db=0.005))
+    recs = []
+    for name, du, dy, da in (("zeroed", 0.0, 0.0, 0.0), ("offsets", 20.0, 5e-3, 9.80665)):
+        path = write_measurement(tmp_path / f"{name}.csv", "SDOFBoucWen", t, {"F": (u["u"] + du, "N", "u")},
+                                 {"Y": (y["y"] + dy, "mm", "y"), "A": (y["a"] + da, "g", "a")})
+        recs.append(sim.record_of(read_measurement(path)))
+    assert recs[1].first == recs[0].first  # the offsets do not make the record look in motion
+    assert np.max(np.abs(recs[1].inputs["u"] - recs[0].inputs["u"])) < 1e-9 * np.max(np.abs(recs[0].inputs["u"]))
+    out = sim.simulate(runner("SDOFBoucWen"), recs[1], {**TRUTH, "exc_type": 0})
+    for k in ("y", "a"):
+        scale = np.max(np.abs(recs[0].outputs[k]))
+        assert np.max(np.abs(recs[1].outputs[k] - recs[0].outputs[k])) < 1e-9 * scale  # the files' 10 digits
+    r0, r1 = (sim.residuals(out, rec) for rec in recs)  # per sample: (sim - meas) / RMS / sqrt(n)
+    # the files' 10 digits of a value with a 5 mm (1 g) offset: about 3e-8 of the channel's RMS per sample
+    assert np.max(np.abs(r1 - r0)) * np.sqrt(recs[0].n) < 1e-7
+    measured("SDOF sweep with a 5 mm transducer zero and a 1 g accelerometer offset, simulated with the truth: "
+             "NRMSE of y and a together", float(np.sqrt(np.sum(r1**2) / 2)), 2e-3)
+
+
+@pytest.mark.parametrize("zero", [0.0, 5e-3])
+def test_a_record_from_rest_is_told_from_a_segment_in_motion_whatever_the_sensor_zero(tmp_path, zero):
+    """A 30 Hz response that builds up from rest (time constant 0.5 s) and a segment of the same motion cut in
+    full swing, each read by a zeroed transducer and by one whose rest reading is 5 mm."""
+    fs = 500.0
+    t = np.arange(int(10 * fs)) / fs
+    growing = 1e-4 * np.sin(2 * np.pi * 30 * t) * (1 - np.exp(-t / 0.5))
+    swinging = 1e-4 * np.sin(2 * np.pi * 30 * t + 1.0)
+    for name, y, at_rest in (("growing", growing, True), ("swinging", swinging, False)):
+        path = write_measurement(tmp_path / f"{name}.csv", "SDOFBoucWen", t, {"F": (y * 1e5, "N", "u")},
+                                 {"Y": (y + zero, "mm", "y")})
+        assert sim.starts_at_rest(read_measurement(path)) is at_rest, name

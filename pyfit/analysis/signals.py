@@ -143,6 +143,14 @@ def sweep_power_impedance(t, force, velocity, phase, frequency, at_hz, cycles: i
     return power, impedance
 
 
+def without_offset(y: np.ndarray) -> np.ndarray:
+    """A channel over the compared samples less its mean. Measured and simulated outputs are compared this
+    way: a sensor's zero (a displacement transducer's rest reading, a load cell carrying the damper's weight,
+    a DC accelerometer's 1 g) is not dynamics, and the least-squares offset between two records is the
+    difference of their means."""
+    return y - np.mean(y)
+
+
 def nrmse(y_ref: np.ndarray, y: np.ndarray) -> float:
     """RMS(y - y_ref) / std(y_ref)."""
     y_ref, y = np.asarray(y_ref), np.asarray(y)

@@ -3,7 +3,8 @@
 kind 'psd_band': the seed's errorVec (design section 3), (PSD_sim - PSD_meas)/PSD_meas on each channel's
 bands, both from identical Welch settings, times sqrt(weight). kind 'psd_log': log(PSD_sim/PSD_meas) on
 the same bins (equal to the relative error near the optimum, but bounded where a resonance is far off,
-which a surrogate learns more easily). kind 'time': (y_sim - y_meas)/std(y_meas) after a warm-up. Parameters enter scaled to [0, 1] within their bounds. A failed or diverging
+which a surrogate learns more easily). kind 'time': (y_sim - y_meas)/std(y_meas) after a warm-up, each less its mean. Measured inputs drive the
+FMU less their mean too (a sensor's zero is neither a load nor a motion). Parameters enter scaled to [0, 1] within their bounds. A failed or diverging
 simulation gives a finite penalty vector and is recorded; nothing non-finite leaves this module.
 """
 from __future__ import annotations
@@ -42,6 +43,7 @@ class Objective:
         self.use_inputs = use_inputs
         self.input_upsample = int(input_upsample)
         self.input_periodic = input_periodic
+        self.inputs = {k: signals.without_offset(v) for k, v in measurement.by_variable("inputs").items()}
         self.fs = measurement.sample_rate_hz
         self.t = measurement.t - measurement.t[0]
         self.first = int(round(warmup_s * self.fs))
@@ -59,7 +61,7 @@ class Objective:
                                      f"(resolution {f[1] - f[0]:.4g} Hz)")
                 self._target[ch.output] = (p, np.any(masks, axis=0))
             else:
-                self._target[ch.output] = (y, float(np.std(y)))
+                self._target[ch.output] = (signals.without_offset(y), float(np.std(y)))
         if kind != "time":
             self.size = sum(int(mask.sum()) for _, mask in self._target.values())
             self._root_w = np.concatenate([np.full(int(self._target[ch.output][1].sum()), np.sqrt(ch.weight))
@@ -78,7 +80,7 @@ class Objective:
         FMU's built-in excitation when use_inputs is off)."""
         outputs = outputs or [c.output for c in self.channels]
         if self.use_inputs:
-            return drive(self.runner, self.m.by_variable("inputs"), self.fs, outputs, self.params(x),
+            return drive(self.runner, self.inputs, self.fs, outputs, self.params(x),
                          self.input_upsample, len(self.t) if self.input_periodic else None, 0, self.tolerance)
         return self.runner.simulate(self.t[-1], 1.0 / self.fs, outputs, self.params(x), tolerance=self.tolerance)
 
@@ -98,7 +100,7 @@ class Objective:
                     _, p = signals.welch_psd(y, self.fs, self.segment_s)
                     r = np.log(np.maximum(p[aux], 1e-300) / target[aux])
                 else:
-                    r = (y - target) / aux
+                    r = (signals.without_offset(y) - target) / aux
                 parts.append(np.sqrt(ch.weight) * r)
             r = np.concatenate(parts)
             ok = bool(np.all(np.isfinite(r)))

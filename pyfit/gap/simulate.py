@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pyfit.analysis import kinematics
+from pyfit.analysis.signals import without_offset
 from pyfit.io.data import Measurement
 from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.drive import drive
@@ -22,7 +23,7 @@ class Record:
     level_value: float
     fs: float
     inputs: dict  # model variable -> samples
-    outputs: dict  # model variable -> samples
+    outputs: dict  # model variable -> the compared samples (from `first` on), less their mean
     samples_per_period: int  # 0: not periodic
     weights: dict = field(default_factory=dict)  # output model variable -> weight in the fits (default 1)
     derived: tuple = ()  # inputs derived from the recorded motion (not measured)
@@ -42,11 +43,14 @@ class Record:
 
 
 def starts_at_rest(m: Measurement, samples: int = 5, fraction: float = 0.05) -> bool:
-    """Whether the record starts from rest: every output stays below `fraction` of its RMS over the first
-    `samples` samples (a response from rest grows from zero; a segment cut from a long record starts at
-    whatever phase the motion had)."""
-    return all(np.max(np.abs(v[:samples])) <= fraction * np.sqrt(np.mean(v**2))
-               for c, v in m.values.items() if c in m.outputs)
+    """Whether the record starts from rest: over the first `samples` samples every output stays within
+    `fraction` of its RMS of the sensor's rest reading, zero (a zeroed sensor) or the record's mean (a sensor
+    with its own zero). A response from rest grows from there; a segment cut from a long record starts at
+    whatever phase the motion had."""
+    def near(v, rest):
+        return np.max(np.abs(v[:samples] - rest)) <= fraction * np.sqrt(np.mean((v - rest) ** 2))
+
+    return all(near(v, 0.0) or near(v, np.mean(v)) for c, v in m.values.items() if c in m.outputs)
 
 
 def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> Record:
@@ -55,6 +59,8 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> R
     motion: the model's displacement, velocity and acceleration inputs (e.g. x_base, v_base, a_base): the
     ones not recorded are derived from the recorded one (pyfit.analysis.kinematics, band-limited to the
     excited band).
+    Every channel, input and output, is taken less its mean (without_offset): a sensor's zero is neither a
+    load nor a motion (the model's equilibrium is the loaded rest position).
     A non-periodic record that does not start at rest (a segment cut from a long record) is simulated from
     rest and its first transient_s seconds (at most a quarter of the record) are not compared (the start-up
     transient of the simulation)."""
@@ -64,7 +70,7 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> R
     if spp and n % spp:
         raise ValueError(f"{m.path}: {n} samples is not a whole number of periods of {spp} "
                          "([excitation] samples_per_period)")
-    inputs = m.by_variable("inputs")
+    inputs = {k: without_offset(v) for k, v in m.by_variable("inputs").items()}  # a sensor's zero is no load
     derived = ()
     if motion:
         recorded = {kind: inputs[var] for kind, var in zip("xva", motion) if var in inputs}
@@ -78,7 +84,7 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> R
     weights = {ch.model_variable: ch.weight for ch in m.outputs.values()}
     # at most a quarter of a short record is given up to the start-up transient
     first = 0 if spp or starts_at_rest(m) else min(int(round(transient_s * m.sample_rate_hz)), n // 4)
-    outputs = {k: v[first:] for k, v in m.by_variable("outputs").items()}
+    outputs = {k: without_offset(v[first:]) for k, v in m.by_variable("outputs").items()}
     # a file without a `level` label is named by its file in every table and figure
     return Record(m.path.stem, m.level or m.path.stem, float(m.level_value if m.level_value is not None else 0.0),
                   m.sample_rate_hz, inputs, outputs, spp, weights, derived, first)
@@ -93,11 +99,12 @@ def scaled(rec: Record, factor: float) -> Record:
 
 def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, lead_periods: int = 1,
              tolerance: float = 1e-8, outputs=None) -> dict | None:
-    """Outputs (model variable -> samples on the record's grid; default: the record's outputs) for FMU
-    parameters params; None on failure. A periodic record is preceded by lead_periods simulated periods."""
+    """Outputs (model variable -> the compared samples of the record's grid, less their mean; default: the
+    record's outputs) for FMU parameters params; None on failure. A periodic record is preceded by
+    lead_periods simulated periods."""
     res = drive(runner, rec.inputs, rec.fs, list(outputs or rec.outputs), params, upsample, rec.samples_per_period,
                 lead_periods if rec.periodic else 0, tolerance)
-    return {k: v[rec.first:] for k, v in res.values.items()} if res.ok else None
+    return {k: without_offset(v[rec.first:]) for k, v in res.values.items()} if res.ok else None
 
 
 def residuals(sim: dict | None, rec: Record, penalty: float = 10.0, of=None) -> np.ndarray:
