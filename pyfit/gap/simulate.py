@@ -22,7 +22,7 @@ class Record:
     level: str
     level_value: float
     fs: float
-    inputs: dict  # model variable -> samples
+    inputs: dict  # model variable -> samples, less their mean
     outputs: dict  # model variable -> the compared samples (from `first` on), less their mean
     samples_per_period: int  # 0: not periodic
     weights: dict = field(default_factory=dict)  # output model variable -> weight in the fits (default 1)
