@@ -141,7 +141,8 @@ def _export(tmp_path, header: str, rows: list[str], unit_x: str = "mm") -> pathl
     path.write_text("\n".join([header] + rows) + "\n")
     path.with_suffix(".toml").write_text("\n".join([
         'model = "SDOFBoucWen"', f"sample_rate_hz = {FS}", 'time_column = "Time, s"', "[inputs]",
-        'F = { unit = "kN", model_variable = "u" }', "[outputs]", f'x = {{ unit = "{unit_x}", model_variable = "y" }}']))
+        'F = { unit = "kN", model_variable = "u" }', "[outputs]",
+        f'x = {{ unit = "{unit_x}", model_variable = "y" }}']))
     return path
 
 

@@ -3,9 +3,10 @@
 kind 'psd_band': the seed's errorVec (design section 3), (PSD_sim - PSD_meas)/PSD_meas on each channel's
 bands, both from identical Welch settings, times sqrt(weight). kind 'psd_log': log(PSD_sim/PSD_meas) on
 the same bins (equal to the relative error near the optimum, but bounded where a resonance is far off,
-which a surrogate learns more easily). kind 'time': (y_sim - y_meas)/std(y_meas) after a warm-up, each less its mean. Measured inputs drive the
-FMU less their mean too (a sensor's zero is neither a load nor a motion). Parameters enter scaled to [0, 1] within their bounds. A failed or diverging
-simulation gives a finite penalty vector and is recorded; nothing non-finite leaves this module.
+which a surrogate learns more easily). kind 'time': (y_sim - y_meas)/std(y_meas) after a warm-up, each less
+its mean. Measured inputs drive the FMU less their mean too (a sensor's zero is neither a load nor a
+motion). Parameters enter scaled to [0, 1] within their bounds. A failed or diverging simulation gives a
+finite penalty vector and is recorded; nothing non-finite leaves this module.
 """
 from __future__ import annotations
 
