@@ -1,7 +1,7 @@
 """One FMU evaluation against the compiled limit, measured in one run.
 
 For the SDOF Bouc-Wen benchmark system (3 periods of the benchmark multisine, 750 Hz samples) and the
-design 1.3 Stockbridge damper (a 35 s constant-velocity clamp sweep 5-40 Hz, 750 Hz samples), the same
+theory §1.3 Stockbridge damper (a 35 s constant-velocity clamp sweep 5-40 Hz, 750 Hz samples), the same
 run is timed three ways:
 
 - the co-simulation FMU through FmuRunner (inputs linear between samples, sent as input derivatives;
@@ -23,7 +23,6 @@ import ctypes
 import pathlib
 import statistics
 import subprocess
-import sys
 import tempfile
 import time
 
@@ -31,24 +30,22 @@ import casadi as ca
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
-from pyfit.analysis.excitation import Excitation, motion_with_derivatives  # noqa: E402
-from pyfit.io import benchmark_data as bd  # noqa: E402
-from pyfit.reference.integrate import simulate_cvodes  # noqa: E402
-from pyfit.reference.models import DAMPER_DEFAULTS, SDOF_DEFAULTS, by_name, damper_matrices  # noqa: E402
-from pyfit.report.readme import BenchReport  # noqa: E402
-from pyfit.runtime.examples import ensure_fmu  # noqa: E402
-from pyfit.runtime.fmu import FmuRunner  # noqa: E402
+from pyfit.analysis.excitation import Excitation, motion_with_derivatives
+from pyfit.io import benchmark_data as bd
+from pyfit.reference.integrate import simulate_cvodes
+from pyfit.reference.models import DAMPER_DEFAULTS, SDOF_DEFAULTS, by_name, damper_matrices
+from pyfit.report.generated import BenchReport
+from pyfit.runtime.examples import ensure_fmu
+from pyfit.runtime.fmu import FmuRunner
 
-GOAL = 3.0
 BARE_C = r"""
 #include <math.h>
 static double sgn(double a) { return (a > 0) - (a < 0); }
 /* the exponent nu is 1 for both models: an engineer writing this loop would not call pow() for it */
 static double fpow(double x, double y) { return y == 1.0 ? x : y == 2.0 ? x * x : pow(x, y); }
 
-/* SDOF Bouc-Wen (design 1.1) with the candidate-effect terms the FMU evaluates (cubic spring k3, Coulomb
+/* SDOF Bouc-Wen (theory §1.1) with the candidate-effect terms the FMU evaluates (cubic spring k3, Coulomb
    friction F_c tanh(v/v_s), quadratic damping c2); state y, v, z;
    p = m, c, k, alpha, beta, gamma, delta, nu, k3, F_c, v_s, c2 */
 static void sdof_rhs(const double *x, double u, const double *p, double *dx) {
@@ -59,7 +56,7 @@ static void sdof_rhs(const double *x, double u, const double *p, double *dx) {
   dx[2] = p[3] * x[1] - p[4] * (p[5] * fabs(x[1]) * sgn(x[2]) * az + p[6] * x[1] * az);
 }
 
-/* damper (design 1.3) with the clamp motion prescribed, with the candidate-effect terms the FMU evaluates
+/* damper (theory §1.3) with the clamp motion prescribed, with the candidate-effect terms the FMU evaluates
    (Coulomb friction F_c,i tanh(dr_i/v_s), quadratic damping c2_i); state q(4), qd(4), z(2); u = x_b, v_b, a_b.
    mat: Minv(16) C(16) K(16) Kfc(4) Mfc(4);
    p: k_bw1 k_bw2 k_cs1 k_cs2 a_bw A beta gamma nu D F_c1 F_c2 v_s c2_1 c2_2 */
@@ -199,7 +196,7 @@ def main():
             steps = (n - 1) * case["n_sub"]
             ratio = t_fmu / t_bare
             report.line(f"{case['label']} ({steps} RK4 steps): FMU via FmuRunner {t_fmu:.4f} s; bare C loop "
-                        f"{t_bare:.4f} s; ratio {ratio:.2f} (goal <= {GOAL:g}: {'met' if ratio <= GOAL else 'NOT met'}); "
+                        f"{t_bare:.4f} s; ratio {ratio:.2f}; "
                         f"CasADi CVODES rtol 1e-8 {t_cv:.3f} s, FMU / CVODES {t_fmu / t_cv:.3f}; "
                         f"FMU vs bare loop relative RMS difference {diff:.1e}")
             runner.close()

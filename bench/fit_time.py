@@ -6,17 +6,14 @@ Goals: <= 60 s and <= -127 dB RMS error on the official multisine.
 """
 import argparse
 import pathlib
-import sys
 import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
-from pyfit.fit.batch import fit_batch  # noqa: E402
-from pyfit.report.readme import BenchReport  # noqa: E402
+from pyfit.fit.batch import fit_batch
+from pyfit.report.generated import BenchReport
 
 CONFIG = ROOT / "configs" / "boucwen_benchmark.toml"
-GOAL_S, GOAL_DB = 60.0, -127.0
 
 
 def main():
@@ -31,10 +28,8 @@ def main():
         raise SystemExit(f"the fit failed: {r['error']}")
     stages = ", ".join(f"{k} {v:.1f} s" for k, v in r["stage_s"].items())
     db = r["benchmark_rms_db"]["multisine"]
-    verdict = "met" if db <= GOAL_DB else "missed"
     report.line(f"Bouc-Wen benchmark fit ({CONFIG.name}, seed {args.seed}, {r['true_evaluations']} FMU runs): "
-                f"{r['wall_s']:.1f} s ({stages}); goal {GOAL_S:.0f} s, ratio {r['wall_s'] / GOAL_S:.2f}; "
-                f"official multisine RMS error {db:.1f} dB (goal <= {GOAL_DB:.0f} dB: {verdict})")
+                f"{r['wall_s']:.1f} s ({stages}); official multisine RMS error {db:.1f} dB")
 
 
 if __name__ == "__main__":

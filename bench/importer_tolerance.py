@@ -6,18 +6,16 @@ without nominals gets). Printed: max |difference| / max |output|.
     python bench/importer_tolerance.py
 """
 import pathlib
-import sys
 
 import fmpy
 import fmpy.sundials
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
-from pyfit.report.readme import BenchReport  # noqa: E402
-from pyfit.runtime.examples import ensure_fmu  # noqa: E402
-from pyfit.runtime.fmu import FmuRunner  # noqa: E402
+from pyfit.report.generated import BenchReport
+from pyfit.runtime.examples import ensure_fmu
+from pyfit.runtime.fmu import FmuRunner
 
 CASES = {"ConductorSpan": ["y_d", "y_e"], "MassSpringDamper": ["y"], "SDOFBoucWen": ["y", "z"],
          "StockbridgeDamper": ["x1", "x2", "F_clamp"]}

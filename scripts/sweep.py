@@ -1,43 +1,5 @@
-"""Run a sweep study (TOML): models x parameter sets x levels (x frequencies); CSV results and figures.
-
-    python scripts/sweep.py CONFIG.toml [--out DIR] [--workers N] [--scheduler ADDRESS] [--fmus fmus]
-"""
-import argparse
-import pathlib
-import sys
-
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-
-from pyfit.io.nominal import load_nominal  # noqa: E402
-from pyfit.io.sweep_config import ConfigError, load_sweep  # noqa: E402
-from pyfit.runtime.examples import ensure_fmu  # noqa: E402
-from pyfit.runtime.sweep import fmu_interface, run_study  # noqa: E402
-
-
-def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("config")
-    ap.add_argument("--out", help="output folder (default: results/<config stem>)")
-    ap.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
-    ap.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
-    ap.add_argument("--fmus", default="fmus", help="folder with the FMUs (built if missing)")
-    ap.add_argument("--nominal", help="TOML describing your system ([nominal] fixed and free parameters)")
-    args = ap.parse_args()
-    fmus = pathlib.Path(args.fmus)
-    try:
-        cfg = load_sweep(args.config, lambda m: fmu_interface(ensure_fmu(m, fmus)),
-                         load_nominal(args.nominal) if args.nominal else None)
-        out = pathlib.Path(args.out or f"results/{cfg.path.stem}")
-        rows = run_study(cfg, fmus, out, args.workers, args.scheduler)
-    except (ConfigError, ValueError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    failed = [r for r in rows if not r["ok"]]
-    for r in failed:
-        print(f"run {r['label']} failed: {r['message']}", file=sys.stderr)
-    print(f"{len(rows) - len(failed)} of {len(rows)} runs done; results in {out}")
-    return 1 if failed else 0
-
+"""`python scripts/sweep.py ARGS` is `stockbridge sweep ARGS` (see `stockbridge sweep --help`)."""
+from pyfit.cli import script
 
 if __name__ == "__main__":
-    sys.exit(main())
+    script("sweep")

@@ -10,7 +10,6 @@ from pyfit.build import EXAMPLES, build_fmu
 from pyfit.runtime.fmu import FmuRunner
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-SHARED_DATA = ROOT.parent / "shared" / "data" / "boucwen"
 
 
 @pytest.fixture(scope="session")
@@ -33,6 +32,23 @@ def fmu_dir(tmp_path_factory, worker_id):
                     build_fmu(EXAMPLES[name], out, name)
                     (out / f"{name}.built").touch()
     return out
+
+
+@pytest.fixture(scope="session")
+def benchmark_dir():
+    """The official Bouc-Wen benchmark validation signals (third-party data, not in the repository): the folder
+    named by BOUCWEN_DATA_DIR, which must then hold them; without it the test is skipped, saying how to get
+    them (the tests never download)."""
+    from pyfit.io import benchmark_data as bd
+
+    named = os.environ.get(bd.ENV_VAR)
+    if not named:
+        pytest.skip(f"needs the Bouc-Wen benchmark signals: {bd.HOW_TO_GET}")
+    folder = pathlib.Path(named)
+    missing = [f"{k}val_{s}.mat" for k in "uy" for s in ("multisine", "sinesweep") if not (folder / f"{k}val_{s}.mat").is_file()]
+    if missing:
+        raise FileNotFoundError(f"{bd.ENV_VAR}={folder} lacks {', '.join(missing)}")
+    return folder
 
 
 @pytest.fixture(scope="session")

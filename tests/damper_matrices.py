@@ -1,4 +1,4 @@
-"""Independent assembly of the damper finite-element model of design section 1.3 (numpy only, not the
+"""Independent assembly of the damper finite-element model of theory §1.3 (numpy only, not the
 Modelica sources): consistent Euler-Bernoulli beam matrices plus the eccentric end masses, default
 parameters. DOFs [x1, phi1, xc, phic, x2, phi2]; the clamp's own mass is not included."""
 import numpy as np

@@ -37,7 +37,8 @@ def test_multisine_estimation_data_has_the_benchmark_properties():
     assert 1e-4 < np.std(y["y"]) < 1e-2  # about 0.7 mm, as the official multisine output
 
 
-def test_benchmark_identification_reaches_minus_120_db_on_the_official_multisine(tmp_path, fmu_dir, measured):
+def test_benchmark_identification_reaches_minus_120_db_on_the_official_multisine(tmp_path, fmu_dir, measured,
+                                                                                  benchmark_dir):
     """Shortened budget and 2 estimation periods instead of 4; the full study is a documented command."""
     text = (ROOT / "configs" / "boucwen_benchmark.toml").read_text()
     text = (text.replace("periods = 4", "periods = 2").replace("budget = 200", "budget = 112")

@@ -1,6 +1,7 @@
 """Span design check: conductor bending stiffness, Poffenberger–Swart against a direct solution of the beam
 with tension, safe border line, energy balance with several dampers, placement against a brute-force grid,
 the SPAN.toml reader and the design_check command."""
+import json
 import math
 import pathlib
 import subprocess
@@ -13,9 +14,10 @@ from scipy.integrate import solve_bvp
 from pyfit.design import conductor as cd
 from pyfit.design import energy_balance as eb
 from pyfit.design import fatigue, placement
+from pyfit.runtime.damper_power import DamperPowerTable, damper_power_table
 from pyfit.design.wind import WindPower
 from pyfit.io.schema import ConfigError
-from pyfit.io.span_config import load_span_design
+from pyfit.design.span_config import load_span_design
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 DRAKE = cd.DRAKE
@@ -131,15 +133,24 @@ def test_the_dampers_reaction_vanishes_for_a_weak_damper_and_matters_for_a_stron
     assert np.all(strong < 0.9 * Y * abs(np.sin(k * x1)))
 
 
-def test_power_law_self_damping_exponents():
-    """P/L = k Y^l f^m / T^n with the tabulated Noiseux (1991) exponents l = 2.44, m = 5.63, n = 2.76."""
-    law = cd.SELF_DAMPING_LAWS["noiseux1991"]
-    assert (law.l, law.m, law.n) == (2.44, 5.63, 2.76)
-    p = lambda f, Y, T: cd.self_damping_power_per_length(law, 1.7, f, Y, T)  # noqa: E731
-    assert p(20, 2e-3, 3e4) / p(20, 1e-3, 3e4) == pytest.approx(2 ** 2.44, rel=1e-12)
-    assert p(40, 1e-3, 3e4) / p(20, 1e-3, 3e4) == pytest.approx(2 ** 5.63, rel=1e-12)
-    assert p(20, 1e-3, 6e4) / p(20, 1e-3, 3e4) == pytest.approx(2 ** -2.76, rel=1e-12)
-    assert p(20, 1e-3, 3e4) == pytest.approx(1.7 * 1e-3 ** 2.44 * 20 ** 5.63 / 30 ** 2.76, rel=1e-12)
+@pytest.mark.parametrize("name", list(cd.SELF_DAMPING_LAWS))
+def test_self_damping_is_the_power_law_its_exponents_say(name):
+    """P/L = k Y^l f^m / T^n: at random (f, Y, T) in the aeolian range, scaling one variable by λ scales the power by
+    λ^l, λ^m or λ^-n (log-log slopes measured on the function, not re-typed), and it is linear in k. A law whose
+    code mixed up the exponents or the units of T (kN) would fail."""
+    law = cd.SELF_DAMPING_LAWS[name]
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        f, Y, T, lam, k = rng.uniform(5, 50), rng.uniform(1e-4, 3e-3), rng.uniform(1e4, 8e4), rng.uniform(1.1, 3), 1.7
+        p = lambda f, Y, T, k=k: cd.self_damping_power_per_length(law, k, f, Y, T)  # noqa: E731
+        assert np.log(p(f, lam * Y, T) / p(f, Y, T)) / np.log(lam) == pytest.approx(law.l, rel=1e-12)
+        assert np.log(p(lam * f, Y, T) / p(f, Y, T)) / np.log(lam) == pytest.approx(law.m, rel=1e-12)
+        assert np.log(p(f, Y, lam * T) / p(f, Y, T)) / np.log(lam) == pytest.approx(-law.n, rel=1e-12)
+        assert p(f, Y, T, k=2 * k) == pytest.approx(2 * p(f, Y, T), rel=1e-14)
+        # T enters in kN: at 1000 N, Y = 1 m, f = 1 Hz the power per length is k itself
+        assert cd.self_damping_power_per_length(law, k, 1.0, 1.0, 1000.0) == pytest.approx(k, rel=1e-14)
+    # the published laws differ: a table that repeated one law under every name would not
+    assert len({(w.l, w.m, w.n) for w in cd.SELF_DAMPING_LAWS.values()}) == len(cd.SELF_DAMPING_LAWS)
 
 
 @pytest.fixture(scope="module")
@@ -147,7 +158,7 @@ def drake_table(fmu_dir):
     """The design damper without its softening cubic springs (k_cs = 0: every run stays stable up to 30 mm,
     so that every configuration resolves) over a coarse band grid (7 frequencies × 7 clamp amplitudes)."""
     freqs = np.geomspace(6.6, 49.8, 7)
-    return eb.damper_power_table(fmu_dir / "DamperElement.fmu", freqs, np.geomspace(1e-5, 3e-2, 7),
+    return damper_power_table(fmu_dir / "DamperElement.fmu", freqs, np.geomspace(1e-5, 3e-2, 7),
                                  {"k_cs1": 0.0, "k_cs2": 0.0}, progress=False)
 
 
@@ -205,7 +216,15 @@ def test_design_check_command_writes_the_report(fmu_dir, tmp_path):
                           "--out", str(tmp_path / "out"), "--workers", "1"], capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr
     md = (tmp_path / "out" / "design_check.md").read_text()
-    assert "Span design check: ACSR Drake" in md and ("PASSES" in md or "FAILS" in md)
+    res = json.loads((tmp_path / "out" / "design_check.json").read_text())
+    # the verdict from the figures: CIGRE use = max stress / endurance stress, IEEE use = strain / 150 µε
+    cigre = res["max_stress_pa"] / res["endurance_stress_pa"]
+    ieee = res["max_strain_pp"] / 150e-6
+    assert res["cigre_use"] == pytest.approx(cigre, rel=1e-12) and res["ieee_use"] == pytest.approx(ieee, rel=1e-12)
+    verdict = "PASSES" if max(cigre, ieee) <= 1 else "FAILS"
+    assert md.startswith("# Span design check: ACSR Drake")
+    assert f"**The span {verdict} with {len(res['recommended_positions_m'])} damper(s)" in md
+    assert f"a margin of {1 - max(cigre, ieee):.0%}" in md
     for name in ("design_amplitude.png", "design_stress.png", "design_positions.png", "design_check.json"):
         assert (tmp_path / "out" / name).is_file()
     bad = tmp_path / "bad.toml"
@@ -238,7 +257,7 @@ def test_measured_impedance_file_replaces_the_damper_model(tmp_path):
         rows += [(f, v, abs(z), np.degrees(np.angle(z))) for v in levels]
     from pyfit.io.impedance import read_impedance
     test = read_impedance(_write_impedance_test(tmp_path, rows))
-    table = eb.DamperPowerTable.from_test(test)
+    table = DamperPowerTable.from_test(test)
     assert table.amplitudes.shape == (12, 3)
     assert table.amplitudes[3, 1] == pytest.approx(0.1 / (2 * np.pi * freqs[3]), rel=1e-12)
     assert table.impedance_at(3, 6e-4) == pytest.approx(c + 1j * 2 * np.pi * freqs[3] * m, rel=1e-8)

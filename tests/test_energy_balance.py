@@ -10,6 +10,7 @@ import pytest
 
 from damper_matrices import clamp_power
 from pyfit.design import energy_balance as eb
+from pyfit.runtime.damper_power import DamperPowerTable, damper_power_table
 from pyfit.design.wind import CIGRE_FNC, PUBLISHED_CURVES, WindPower
 
 DRAKE_LAB = eb.Conductor(eb.DRAKE_DIAMETER, 1.628, 28e3, 30.0, 0.002)
@@ -99,7 +100,7 @@ def test_balance_with_a_published_wind_curve():
 def test_damper_table_interpolates_impedance_linearly_in_log_amplitude():
     amps = np.geomspace(1e-5, 1e-2, 7)
     z = (3.0 + 2.0 * np.log(amps)) + 1j * (1.0 - 0.5 * np.log(amps))  # linear in log a: reproduced exactly
-    table = eb.DamperPowerTable(np.array([10.0]), amps, np.zeros((1, 7)), np.zeros((1, 7)), z[None, :])
+    table = DamperPowerTable(np.array([10.0]), amps, np.zeros((1, 7)), np.zeros((1, 7)), z[None, :])
     for a in (2e-5, 3.3e-4, 9e-3):
         assert table.impedance_at(0, a) == pytest.approx((3.0 + 2.0 * np.log(a)) + 1j * (1.0 - 0.5 * np.log(a)),
                                                          rel=1e-12)
@@ -115,7 +116,7 @@ def test_damper_fmu_power_matches_independent_harmonic_solution(fmu_dir, measure
     # zeta 2.2 %) has decayed to exp(-0.022 * 63.5 * 6) = 2e-4 of its start by then.
     linear = {"k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0}
     freqs, amps = [5.0, 10.0, 17.3, 30.0], [5e-4]
-    table = eb.damper_power_table(fmu_dir / "DamperElement.fmu", freqs, amps, linear, workers=1, progress=False)
+    table = damper_power_table(fmu_dir / "DamperElement.fmu", freqs, amps, linear, workers=1, progress=False)
     measured("damper FMU mean clamp power, linear damper, 0.5 mm at 5, 10, 17.3, 30 Hz vs a harmonic solution of "
              "independently assembled 6-DOF matrices: max relative error",
              max(abs(table.power[i, 0] / clamp_power(f, amps[0]) - 1) for i, f in enumerate(freqs)), 1e-3)

@@ -46,7 +46,8 @@ SCALES = {
 }
 
 
-@pytest.fixture(scope="module", params=["benchmark", pytest.param("electronic", marks=pytest.mark.slow)])
+@pytest.fixture(scope="module", params=[pytest.param("benchmark", marks=pytest.mark.slow),
+                                        pytest.param("electronic", marks=pytest.mark.slow)])
 def duffing_dataset(request, tmp_path_factory):
     osc = SCALES[request.param]
     rng = np.random.default_rng(7)

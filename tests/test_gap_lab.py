@@ -69,7 +69,7 @@ def _foreign_export(src: pathlib.Path, dst: pathlib.Path) -> pathlib.Path:
     from pyfit.io.data import read_measurement
 
     unit = {"x_base": ("mm", 1e3), "F_clamp": ("kN", 1e-3), "acc_x1": ("g", 1 / 9.80665)}
-    weight = 9.80665 * (0.8 + 0.6 + 0.6 + 0.3 * (0.17 + 0.12))  # N: m1 + m2 + m_c + mu (L1 + L2), design 1.3
+    weight = 9.80665 * (0.8 + 0.6 + 0.6 + 0.3 * (0.17 + 0.12))  # N: m1 + m2 + m_c + mu (L1 + L2), theory §1.3
     zero = {"x_base": 2e-3, "F_clamp": weight, "acc_x1": 9.80665}  # SI
     dst.mkdir(parents=True)
     files = sorted(src.glob("*.csv"))

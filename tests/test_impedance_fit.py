@@ -13,7 +13,7 @@ from pyfit.reference.impedance import reference_impedance
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 TRUTH = {"k_bw1": 400.0, "k_bw2": 350.0}  # N/m; the FMU's defaults are 300 and 500
-LEVELS = [0.02, 0.05]  # m/s, clamp velocity amplitudes (design §1.3 test levels ≤ 0.05 m/s)
+LEVELS = [0.02, 0.05]  # m/s, clamp velocity amplitudes (theory §1.3 test levels ≤ 0.05 m/s)
 NOISE = (0.005, np.radians(0.3))  # 0.5 % in |Z|, 0.3° in phase
 # (frequencies [Hz], free parameters): the default run fits k_bw1 at two frequencies; the slow one both
 # stiffnesses at four, through both damper resonances

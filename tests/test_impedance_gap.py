@@ -57,6 +57,7 @@ def test_null_case_is_no_significant_gap(fmu_dir, tmp_path, measured, monkeypatc
     assert again["heldout_error_nominal"] == rep["heldout_error_nominal"]
 
 
+@pytest.mark.slow
 def test_withheld_cubic_stiffness_is_named(fmu_dir, tmp_path, measured, monkeypatch):
     case = write_impedance_case(tmp_path / "damper_cubic", "cubic_stiffness")
     cfg = DiagnoseConfig(**{**SHORT.__dict__, "effects": ["cubic_stiffness", "quadratic_damping"]})

@@ -1,38 +1,65 @@
-"""Every figure in the README's generated blocks is the content of a committed file a command writes."""
+"""The README and the docs: every figure in a generated block is the content of a committed file a command
+writes; the README is short, names only what a clone holds, and its two set-up commands are the documented
+ones; its Python example runs."""
+import os
 import pathlib
 import re
 import shutil
 
-from pyfit.report import readme
+from pyfit.report import generated
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 
-def test_readme_blocks_equal_their_result_files():
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
-    assert len(readme.blocks(text)) >= 5
-    assert readme.stale(text, ROOT) == []
+def test_generated_blocks_equal_their_result_files():
+    pages = {p: generated.blocks(p.read_text(encoding="utf-8")) for p in generated.pages(ROOT)}
+    assert sum(len(b) for b in pages.values()) >= 10 and pages[ROOT / "README.md"]
+    assert generated.stale_files(ROOT) == []
 
 
 def test_a_changed_number_in_a_result_file_is_caught(tmp_path):
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
-    path, _ = readme.blocks(text)[0]
-    (tmp_path / path).parent.mkdir(parents=True)
-    shutil.copyfile(ROOT / path, tmp_path / path)
-    for p, _ in readme.blocks(text)[1:]:
+    text = (ROOT / "docs" / "validation.md").read_text(encoding="utf-8")
+    paths = [p for p, _ in generated.blocks(text)]
+    for p in paths:
         (tmp_path / p).parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(ROOT / p, tmp_path / p)
-    assert readme.stale(text, tmp_path) == []
-    content = (tmp_path / path).read_text(encoding="utf-8")
+    page_dir = tmp_path / "docs"
+    assert generated.stale(text, tmp_path, page_dir) == []
+    content = (tmp_path / paths[0]).read_text(encoding="utf-8")
     number = re.search(r"\d+\.\d+", content)
     changed = content[:number.start()] + str(float(number.group()) + 1.0) + content[number.end():]
-    (tmp_path / path).write_text(changed, encoding="utf-8")
-    assert readme.stale(text, tmp_path) == [path]
-    assert readme.stale(readme.render(text, tmp_path), tmp_path) == []
+    (tmp_path / paths[0]).write_text(changed, encoding="utf-8")
+    assert generated.stale(text, tmp_path, page_dir) == [paths[0]]
+    assert generated.stale(generated.render(text, tmp_path, page_dir), tmp_path, page_dir) == []
 
 
-def test_readme_has_exactly_two_setup_commands():
+def test_a_block_in_a_subfolder_page_re_points_relative_links(tmp_path):
+    (tmp_path / "docs" / "results").mkdir(parents=True)
+    (tmp_path / "docs" / "results" / "r.md").write_text("![fig](r_fig.png) [page](../theory.md) [web](https://x.org/a)\n")
+    text = "<!-- generated from docs/results/r.md -->\n<!-- end generated -->\n"
+    assert "](results/r_fig.png) [page](theory.md) [web](https://x.org/a)" in generated.render(
+        text, tmp_path, tmp_path / "docs")
+    assert "](../results/r_fig.png) [page](../theory.md)" in generated.render(text, tmp_path, tmp_path / "docs" / "guide")
+    assert "](docs/results/r_fig.png) [page](docs/theory.md)" in generated.render(text, tmp_path)
+
+
+def test_readme_is_short_has_two_setup_commands_and_names_nothing_outside_the_clone():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert len(text.splitlines()) <= 200
     setup = text.split("## Set-up", 1)[1].split("```bash", 1)[1].split("```", 1)[0]
     commands = [line for line in setup.splitlines() if line.strip() and not line.lstrip().startswith("#")]
-    assert commands == ["pip install -e . && python scripts/fit.py", "python -m pytest"]
+    assert commands == ['pip install -e ".[test]" && stockbridge fit', "python -m pytest"]
+    for page in generated.pages(ROOT):
+        words = page.read_text(encoding="utf-8")
+        assert "../shared" not in words and "design §" not in words and "design.md" not in words, page
+    for link in re.findall(r"\]\(([^)#\s]+)", text):  # every local link of the README exists in the clone
+        assert link.startswith("http") or (ROOT / link).exists(), link
+
+
+def test_the_readme_python_example_runs(fmu_dir, tmp_path, monkeypatch, capsys):
+    code = (ROOT / "README.md").read_text(encoding="utf-8").split("```python\n", 1)[1].split("```", 1)[0]
+    os.symlink(fmu_dir, tmp_path / "fmus")
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, "README.md", "exec"), {})
+    power = float(re.search(r"mean power over the sweep: ([0-9.]+) W", capsys.readouterr().out)[1])
+    assert power > 0  # a damper dissipates: F_clamp·v_clamp > 0 in the IEC 61897 sign convention

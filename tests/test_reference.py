@@ -45,5 +45,5 @@ def test_newmark_converges_to_cvodes_at_second_order(name, exc, stop, measured):
         nm = integrate.simulate_newmark(model, fine, excitation=exc)
         errors.append(np.max(np.abs(nm[out][::round(1e-3 / h)] - ref[out])) / np.max(np.abs(ref[out])))
     assert errors[0] < 1e-3
-    measured(f"{name}: the seed's Newmark scheme vs CVODES, error ratio for h = 1e-4 → 5e-5 s (second order: 4)",
+    measured(f"{name}: the thesis's Newmark scheme vs CVODES, error ratio for h = 1e-4 → 5e-5 s (second order: 4)",
              abs(errors[0] / errors[1] - 4), 0.5)

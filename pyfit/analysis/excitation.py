@@ -1,4 +1,4 @@
-"""Excitation signals of design section 2, as functions of time that work on numpy arrays and on CasADi symbols.
+"""Excitation signals of theory §2, as functions of time that work on numpy arrays and on CasADi symbols.
 
 The same formulas are built into the FMUs (Modelica `Sources.Excitation`); these are an independent
 implementation, used to drive the CasADi reference and to make input arrays.

@@ -1,4 +1,4 @@
-"""Signal analysis for hysteretic systems (design section 3): PSD, FRF, loops, power, metrics.
+"""Signal analysis for hysteretic systems (theory §3): PSD, FRF, loops, power, metrics.
 
 Every function takes samples on a uniform time grid; `assert_uniform` checks it before spectra.
 Units follow the signals (SI); PSDs are one-sided in unit^2/Hz.

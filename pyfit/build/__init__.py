@@ -9,7 +9,7 @@ import pathlib
 import tempfile
 from dataclasses import dataclass
 
-from pyfit.build.catalog import EXAMPLES, LIBRARY, ModelicaError
+from pyfit.catalog import EXAMPLES, LIBRARY, ModelicaError
 
 __all__ = ["ModelicaError", "EXAMPLES", "build_fmu", "build_all", "fmi3_path", "LIBRARY"]
 

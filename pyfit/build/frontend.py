@@ -14,7 +14,7 @@ import casadi as ca
 if not hasattr(ca.MX, "__div__"):
     ca.MX.__div__ = ca.MX.__truediv__
 
-from pyfit.build.catalog import ModelicaError  # noqa: E402
+from pyfit.catalog import ModelicaError  # noqa: E402
 from pymoca import parser as mo_parser  # noqa: E402
 from pymoca import tree as mo_tree  # noqa: E402
 from pymoca import ast as mo_ast  # noqa: E402

@@ -1,7 +1,7 @@
 """The span design check: from a SPAN.toml and the damper FMU to a report an engineer can hand on.
 
 Steps: the aeolian band of the conductor (Strouhal × wind range / D); the damper's clamp impedance over that
-band and a range of clamp amplitudes (the DamperElement FMU, `energy_balance.damper_power_table`, or a
+band and a range of clamp amplitudes (the DamperElement FMU, `pyfit.runtime.damper_power.damper_power_table`, or a
 measured impedance test); steady amplitudes by the energy balance (the wind power curve with turbulence,
 the self-damping law, every damper at its own position, with its reaction on the string); the
 Poffenberger–Swart stress at the clamp; the best positions for 1…max_dampers dampers
@@ -18,10 +18,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from pyfit.design import fatigue, placement
-from pyfit.design.energy_balance import Conductor, DamperPowerTable, damper_power_table
+from pyfit.design.energy_balance import Conductor
+from pyfit.runtime.damper_power import DamperPowerTable, damper_power_table
 from pyfit.io.impedance import read_impedance
 from pyfit.io.schema import ConfigError
-from pyfit.io.span_config import SpanDesign
+from pyfit.design.span_config import SpanDesign
 from pyfit.report import plots
 
 
@@ -120,7 +121,7 @@ def write_report(result: DesignResult, out_dir) -> pathlib.Path:
     verdict = "PASSES" if fat["passes"] else "FAILS"
     damper = (f"measured impedance `{d.impedance_file.name}`" if d.impedance_file else "DamperElement FMU" + (
         " with " + ", ".join(f"{k} = {v:g}" for k, v in sorted(d.damper_parameters.items()))
-        if d.damper_parameters else " (design §1.3 defaults)"))
+        if d.damper_parameters else " (theory §1.3 defaults)"))
     lines = [f"# Span design check: {c.name}, {d.length:g} m at {d.tension / 1e3:.1f} kN ({d.tension / c.rts:.0%} RTS)", "",
              f"**The span {verdict} with {len(result.recommended.positions)} damper(s) at {_positions(result.recommended)} "
              f"from the suspension clamp: the worst fatigue use is {1 - fat['margin']:.2f} of the limit, a margin of "

@@ -79,8 +79,8 @@ def reduction_table(span_fmu, damper_fmu, modes, positions, **kw) -> list[ModeDe
     return [mode_decay(span_fmu, damper_fmu, n, x, **kw) for x in positions for n in modes]
 
 
-def write_report(rows: list[ModeDecay], out_dir) -> None:
-    """reduction.md (table per mode and position), reduction.csv and reduction.png into out_dir."""
+def write_report(rows: list[ModeDecay], out_dir) -> pathlib.Path:
+    """reduction.md (table per mode and position), reduction.csv and reduction.png into out_dir; the .md path."""
 
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -104,3 +104,14 @@ def write_report(rows: list[ModeDecay], out_dir) -> None:
         (f"damper at {x:g} m", [by[n, x].frequency_hz for n in modes], [by[n, x].amplitude_ratio for n in modes],
          "o-") for x in positions], "mode frequency [Hz]", "resonant amplitude ratio [-]",
         "Span with a Stockbridge damper: amplitude with / without damper", ylim=(0, 1.05), log=False)
+    return out / "reduction.md"
+
+
+def write_span_ssp(path, span_fmu, damper_fmu, x_d: float) -> pathlib.Path:
+    """The span with the damper at x_d [m] as an SSP 1.0 archive for other FMI tools (span excited on its
+    built-in mode, damper clamp mass left to the span); returns the archive's path."""
+    from pyfit.runtime.ssp import write_ssp
+
+    write_ssp(path, "SpanWithDamper", {"span": span_fmu.path, "damper": damper_fmu.path}, CONNECTIONS,
+              {"span": {"exc_type": 1, "x_d": x_d}, "damper": {"m_c": 0.0}}, stop_time=10.0)
+    return pathlib.Path(path)

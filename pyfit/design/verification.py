@@ -18,7 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pyfit.design.conductor import PowerLaw
-from pyfit.design.energy_balance import Conductor, damper_power_table, steady_amplitude
+from pyfit.design.energy_balance import Conductor, steady_amplitude
+from pyfit.runtime.damper_power import damper_power_table
 from pyfit.design.span import CONNECTIONS, span_properties
 from pyfit.runtime.cosim import cosimulate
 from pyfit.runtime.fmu import FmuRunner

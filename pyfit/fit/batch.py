@@ -155,7 +155,7 @@ def summary_markdown(results: list[dict]) -> str:
                   f"{r['wall_s']:.1f} | " + ", ".join(f"{k}: {100 * v:+.3f} %" for k, v in r["recovery"].items()) + " |"
                   for r in recovered]
     lines += nno_vs_ga_markdown(results)
-    bench = [r for r in results if "benchmark_rms_db" in r]
+    bench = [r for r in results if r.get("benchmark_rms_db")]
     if bench:
         lines += ["", "Bouc-Wen benchmark, RMS error on the official validation signals [dB re 1 m]:", "",
                   "| config | seed | multisine | sinesweep |", "|---|---|---|---|"]

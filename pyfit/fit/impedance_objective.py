@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyfit.design.energy_balance import damper_power_table
+from pyfit.runtime.damper_power import damper_power_table
 from pyfit.io.fit_config import FreeParameter
 from pyfit.io.impedance import ImpedanceTest
 

@@ -1,6 +1,6 @@
 """The fitting objective: FMU simulation of an experiment -> residual vector against a measurement.
 
-kind 'psd_band': the seed's errorVec (design section 3), (PSD_sim - PSD_meas)/PSD_meas on each channel's
+kind 'psd_band': the thesis's errorVec (theory §3), (PSD_sim - PSD_meas)/PSD_meas on each channel's
 bands, both from identical Welch settings, times sqrt(weight). kind 'psd_log': log(PSD_sim/PSD_meas) on
 the same bins (equal to the relative error near the optimum, but bounded where a resonance is far off,
 which a surrogate learns more easily). kind 'time': (y_sim - y_meas)/std(y_meas) after a warm-up, each less
@@ -120,7 +120,7 @@ class Objective:
         return float(np.sum(self.residuals(x) ** 2))
 
     def band_error_percent(self, x) -> dict[str, float]:
-        """The seed's '% error' per channel: RMS over the band bins of (PSD - PSD_meas)/PSD_meas, in %."""
+        """The thesis's '% error' per channel: RMS over the band bins of (PSD - PSD_meas)/PSD_meas, in %."""
         res = self.simulate(x)
         out = {}
         for ch in self.channels:

@@ -193,7 +193,9 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
     can be far from it)."""
     start, bounds, fixed = effect_start(system, effect, scale, nominal.params)
     strengths = [{}] + [{n: v * f for n, v in strength.items()} for f in STRENGTH_FACTORS] if strength else [{}]
-    alternatives = [s for s in strengths if s]
+    # the effect at zero is the calibrated nominal: with it among the starts, a refit never ends worse than it
+    alternatives = [{**{n: nominal.params[n] for n in system.linear}, **effect.absent(scale)}]
+    alternatives += [s for s in strengths if s]
     for linear in linear_starts:
         lin_start, lin_bounds, _ = effect_start(system, effect, scale, nominal.params, linear)
         bounds = {n: (min(bounds[n][0], lin_bounds[n][0]), max(bounds[n][1], lin_bounds[n][1])) for n in bounds}

@@ -1,4 +1,4 @@
-"""Withheld-effect datasets: design-section-5 measurements from a truth model that contains one effect
+"""Withheld-effect datasets: measurement files (theory §5) from a truth model that contains one effect
 the nominal model lacks (or none: null cases), at three excitation levels.
 
 No inverse crime: the truth is the CasADi reference integrated by CVODES (rtol 1e-10) at 10x the sensor
@@ -52,9 +52,9 @@ SDOF = Family(
 _DAMPER_OFF = {"k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "F_c1": 0.0, "F_c2": 0.0, "c2_1": 0.0,
                "c2_2": 0.0}
 DAMPER = Family(
-    "StockbridgeDamper", dict(_DAMPER_OFF),  # the linear FE damper of design 1.3, its eccentric masses included
+    "StockbridgeDamper", dict(_DAMPER_OFF),  # the linear FE damper of theory §1.3, its eccentric masses included
     {"hysteresis": {"k_bw1": 600.0, "k_bw2": 1000.0, "D": 2e-4},
-     "cubic_stiffness": {"k_cs1": 8e8, "k_cs2": 2.4e9},  # hardening: the seed's softening diverges here
+     "cubic_stiffness": {"k_cs1": 8e8, "k_cs2": 2.4e9},  # hardening: the thesis's softening diverges here
      "coulomb_friction": {"F_c1": 0.08, "F_c2": 0.12, "v_s": 1e-3},
      "quadratic_damping": {"c2_1": 12.0, "c2_2": 20.0},
      "mass_eccentricity": {"a1": lambda p: p["a1"] + 0.015, "a2": lambda p: p["a2"] + 0.015},  # 15 mm further out

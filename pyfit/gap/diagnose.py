@@ -153,7 +153,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     within the noise floor, no effect is refitted (verdict 'no significant gap').
 
     nominal: the user's description of the nominal model (a NominalModel or a TOML file, see
-    pyfit.io.nominal); None: the FMU's defaults (for the damper, the design 1.3 reference damper)."""
+    pyfit.io.nominal); None: the FMU's defaults (for the damper, the theory §1.3 reference damper)."""
     from pyfit.gap import report
 
     clock = StageClock()

@@ -2,7 +2,7 @@
 frequency at three or more clamp-velocity levels) instead of time records.
 
 The nominal (linear) damper is calibrated on the lowest and highest level; its misfit on the levels between
-them is the gap (where: by frequency); each candidate effect of design section 6 is added and refitted on the
+them is the gap (where: by frequency); each candidate effect of theory §6 is added and refitted on the
 same two levels (which), and judged by how far it shrinks the misfit on the held-out levels (how far). The
 misfit is the RMS over test points of |Z_model / Z_meas − 1| (a relative error ε in |Z| or ε rad of phase
 counts ε), judged against the test's stated measurement uncertainty (an impedance table carries no noise
@@ -141,7 +141,7 @@ def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu
                        nominal: NominalModel | str | None = None, uncertainty: float | None = None,
                        workers: int | None = None) -> dict:
     """Diagnose a damper's impedance test against the nominal damper (a NominalModel or TOML file; None: the
-    design 1.3 damper); `uncertainty`: the test's relative measurement error (RMS of |Z_meas / Z_true − 1|;
+    theory §1.3 damper); `uncertainty`: the test's relative measurement error (RMS of |Z_meas / Z_true − 1|;
     None: the value its sidecar states). The effects are refitted in parallel on `workers` processes (None:
     one per core); finished fits are kept in OUT/fits/ (a rerun with the same OUT redoes only the unfinished
     ones). Writes OUT/report.json, OUT/report.md and the impedance figures; returns the report."""

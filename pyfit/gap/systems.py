@@ -1,5 +1,5 @@
 """The systems a diagnosis knows: FMU, nominal (linear) free parameters with their start and bounds, and
-the candidate effects of design section 6. The nominal model is what the user describes
+the candidate effects of theory §6. The nominal model is what the user describes
 (pyfit.io.nominal.NominalModel); every dimension not described comes from the FMU's own defaults (the .mo
 files), none is written here.
 
@@ -48,6 +48,15 @@ class Effect:
     fixed: callable = field(default=lambda s: {})
     signature: str = ""
     shift_stiffness: float = 0.0  # the effect's start adds this fraction of the stiffness, taken off the nominal
+
+    def absent(self, scale: Scale) -> dict:
+        """Parameter values at which the effect is not there (the nominal model): strengths at zero where their
+        range holds it, shape parameters and deviations (e.g. the mass offsets) at their start."""
+        out = {}
+        for p in self.params:
+            lo, st, hi = p.range(scale)
+            out[p.name] = 0.0 if (not p.shape and lo <= 0.0 <= hi) else st
+        return out
 
 
 @dataclass(frozen=True)

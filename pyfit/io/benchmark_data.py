@@ -1,6 +1,9 @@
-"""The official Bouc-Wen benchmark validation signals (Noel & Schoukens): loading and validation runs.
+"""The official Bouc-Wen benchmark validation signals (Noël & Schoukens 2016, nonlinearbenchmark.org).
 
-Used for validation and reporting only, never for estimation (see shared/data/boucwen/README.md).
+Third-party data, not shipped with the package. They are read from the folder named by the environment
+variable BOUCWEN_DATA_DIR (the four files uval_/yval_multisine.mat and uval_/yval_sinesweep.mat), else
+through the benchmark's official loader package `nonlinear-benchmarks` (the extra `benchmark`; it downloads
+the files once, on a machine with internet). Used to validate and report, never to estimate.
 """
 from __future__ import annotations
 
@@ -11,13 +14,31 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.io
 
-from pyfit.analysis.signals import rms_db  # noqa: F401  (rms_db: the figure of merit)
-from pyfit.runtime.drive import drive
-
 FS_HZ = 750.0  # sampling frequency of the official signals (not stored in the files)
-# ../shared/data/boucwen beside the repository, or the folder named by BOUCWEN_DATA_DIR
-DEFAULT_DIR = pathlib.Path(os.environ.get("BOUCWEN_DATA_DIR")
-                           or pathlib.Path(__file__).resolve().parents[3] / "shared" / "data" / "boucwen")
+ENV_VAR = "BOUCWEN_DATA_DIR"
+HOW_TO_GET = (f"set {ENV_VAR} to a folder holding uval_multisine.mat, yval_multisine.mat, uval_sinesweep.mat "
+              "and yval_sinesweep.mat (the benchmark's validation signals, nonlinearbenchmark.org), or install "
+              "the official loader on a machine with internet: pip install nonlinear-benchmarks")
+
+
+class BenchmarkDataMissing(FileNotFoundError):
+    """The benchmark signals are not on this machine; the message says how to get them."""
+
+
+def data_folder() -> pathlib.Path:
+    """The folder with the four validation files: BOUCWEN_DATA_DIR, else the official loader's cache."""
+    named = os.environ.get(ENV_VAR)
+    if named:
+        return pathlib.Path(named)
+    try:
+        from nonlinear_benchmarks.not_splitted_benchmarks import BoucWen
+    except ImportError:
+        raise BenchmarkDataMissing(f"Bouc-Wen benchmark signals not found: {HOW_TO_GET}") from None
+    try:
+        return pathlib.Path(BoucWen(data_file_locations=True))
+    except Exception as exc:  # the loader's download failed (no internet): say so, with the other way
+        raise BenchmarkDataMissing(f"the nonlinear-benchmarks loader could not fetch the Bouc-Wen files ({exc}); "
+                                   f"{HOW_TO_GET}") from exc
 
 
 @dataclass
@@ -30,39 +51,22 @@ class ValidationSignal:
     periodic: bool
 
 
-def load(name: str, folder: pathlib.Path = DEFAULT_DIR) -> ValidationSignal:
-    """Load 'multisine' (one steady-state period) or 'sinesweep' (from rest)."""
+def load(name: str, folder: pathlib.Path | None = None) -> ValidationSignal:
+    """Load 'multisine' (one steady-state period) or 'sinesweep' (from rest), from `folder` or data_folder()."""
     if name not in ("multisine", "sinesweep"):
         raise ValueError(f"unknown benchmark signal '{name}'; valid: multisine, sinesweep")
-    folder = pathlib.Path(folder)
+    folder = pathlib.Path(folder) if folder is not None else data_folder()
     for kind in "uy":
         if not (folder / f"{kind}val_{name}.mat").is_file():
-            raise FileNotFoundError(f"{folder / f'{kind}val_{name}.mat'}: benchmark signal not found (put "
-                                    "../shared/data/boucwen beside the repository or set BOUCWEN_DATA_DIR)")
+            raise BenchmarkDataMissing(f"{folder / f'{kind}val_{name}.mat'}: benchmark signal not found; "
+                                       f"{HOW_TO_GET}")
     u = scipy.io.loadmat(folder / f"uval_{name}.mat")[f"uval_{name}"].ravel().astype(float)
     y = scipy.io.loadmat(folder / f"yval_{name}.mat")[f"yval_{name}"].ravel().astype(float)
     return ValidationSignal(name, u, y, periodic=name == "multisine")
 
 
-def simulate_validation(runner, signal: ValidationSignal, upsample: int = 20, periods: int = 3,
-                        params: dict | None = None, tolerance: float = 1e-10) -> np.ndarray:
-    """Simulate the SDOF FMU (co-simulation, input derivatives) on a validation input; return y at FS_HZ.
-
-    Multisine: band-limited upsampling, `periods` periods, the last one returned (steady state).
-    Sweep: spline upsampling, from rest.
-    """
-    p = {"exc_type": 0}
-    p.update(params or {})
-    n = len(signal.u)
-    res = drive(runner, {"u": signal.u}, FS_HZ, ["y"], p, upsample, n if signal.periodic else None,
-                periods - 1 if signal.periodic else 0, tolerance)
-    if not res.ok:
-        raise RuntimeError(f"benchmark simulation failed: {res.message}")
-    return res["y"]
-
-
-def write_dataset(out_dir, folder: pathlib.Path = DEFAULT_DIR) -> pathlib.Path:
-    """The two official signals as a design-section-5 dataset (for the gap-diagnosis demonstration that
+def write_dataset(out_dir, folder: pathlib.Path | None = None) -> pathlib.Path:
+    """The two official signals as a measurement dataset (theory §5) (for the gap-diagnosis demonstration that
     the data README allows: calibrate on the multisine, judge on the sweep)."""
     from pyfit.io.data import write_measurement
 

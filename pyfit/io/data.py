@@ -1,4 +1,4 @@
-"""Measurement files (design section 5): a CSV plus a TOML sidecar of the same stem.
+"""Measurement files (theory §5): a CSV plus a TOML sidecar of the same stem.
 
 Sidecar keys: model, sample_rate_hz, [inputs] and [outputs] mapping column -> {unit, model_variable[, weight]};
 optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s" or "ms").
@@ -20,16 +20,20 @@ non-numeric or non-finite values in a used column.
 from __future__ import annotations
 
 import csv
+import io
 import pathlib
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from pyfit.io.schema import ConfigError, check_table, fail, read_toml
+from pyfit.io.schema import ConfigError, check_table, fail, read_text, read_toml
 
 TO_SI = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "rad": 1.0, "deg": np.pi / 180, "m/s": 1.0, "mm/s": 1e-3,
          "m/s2": 1.0, "mm/s2": 1e-3, "g": 9.80665, "N": 1.0, "kN": 1e3}
 TIME_UNITS = {"s": 1.0, "ms": 1e-3}
+MAX_ABS_SI = 1e100  # largest magnitude of a measured value in SI units: its square over a million samples,
+#                      and its derivatives at MHz rates, stay far inside double precision (1.8e308)
 MAX_TIME_SLIP = 0.25  # largest allowed distance [samples] of a time stamp from the uniform grid
 SIDECAR = {"model": (str, True, None), "sample_rate_hz": ("number", True, None), "inputs": (dict, False, {}),
            "outputs": (dict, True, None), "level": (str, False, ""), "level_value": ("number", False, None),
@@ -124,9 +128,14 @@ class _Header:
     units: dict[str, str]
 
 
-def _header(csv_path: pathlib.Path) -> _Header:
+def _lines(text: str) -> io.StringIO:
+    """The decoded file as lines, whatever its line ends (LF, CRLF or CR)."""
+    return io.StringIO(text, newline=None)
+
+
+def _header(csv_path: pathlib.Path, text: str) -> _Header:
     """Read the lines before the data: '#' comments, the header, and a units row if there is one."""
-    with open(csv_path, encoding="utf-8-sig") as f:
+    with _lines(text) as f:
         for skip, line in enumerate(f, 1):
             if line.strip() and not line.lstrip().startswith("#"):
                 break
@@ -159,27 +168,30 @@ def _header(csv_path: pathlib.Path) -> _Header:
     return _Header(names, skip, delimiter, units)
 
 
-def _load_columns(csv_path, head: _Header, wanted: list[str]) -> dict[str, np.ndarray]:
+def _load_columns(csv_path, text: str, head: _Header, wanted: list[str]) -> dict[str, np.ndarray]:
     idx = [head.names.index(w) for w in wanted]
     try:
-        data = np.loadtxt(csv_path, delimiter=head.delimiter, skiprows=head.skip, usecols=idx, ndmin=2,
-                          comments="#", quotechar='"', encoding="utf-8-sig")
+        with warnings.catch_warnings():  # an empty body is refused below, with the file named
+            warnings.simplefilter("ignore", UserWarning)
+            data = np.loadtxt(_lines(text), delimiter=head.delimiter, skiprows=head.skip, usecols=idx, ndmin=2,
+                              comments="#", quotechar='"')
     except ValueError as exc:
         raise MeasurementError(f"{csv_path}: not numeric in a used column ({', '.join(wanted)}): {exc}; "
                                "allowed: numbers with '.' as the decimal mark") from exc
+    if data.shape[0] == 0:
+        raise MeasurementError(f"{csv_path}: no data rows after row {head.skip}; allowed: at least two samples")
     return dict(zip(wanted, data.T))
 
 
 def read_csv_columns(csv_path, wanted: list[str]) -> dict[str, np.ndarray]:
     """The named columns of a lab-style CSV (comment lines, ',' or tab, extra columns), as floats."""
     csv_path = pathlib.Path(csv_path)
-    if not csv_path.is_file():
-        raise MeasurementError(f"{csv_path}: file not found")
-    head = _header(csv_path)
+    text = read_text(csv_path, MeasurementError)
+    head = _header(csv_path, text)
     for w in wanted:
         if w not in head.names:
             raise MeasurementError(f"{csv_path}: no column {w!r}; columns: {', '.join(head.names)}")
-    return _load_columns(csv_path, head, wanted)
+    return _load_columns(csv_path, text, head, wanted)
 
 
 def check_time(t: np.ndarray, fs: float, csv_path, side, column: str, first_row: int) -> None:
@@ -226,7 +238,8 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
         fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join(TIME_UNITS), MeasurementError)
     inputs = _channels(side, meta["inputs"], "inputs")
     outputs = _channels(side, meta["outputs"], "outputs")
-    head = _header(csv_path)
+    text = read_text(csv_path, MeasurementError)
+    head = _header(csv_path, text)
     names, skip = head.names, head.skip
     for name, ch in {**inputs, **outputs}.items():
         if name not in names:
@@ -242,7 +255,7 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
         raise MeasurementError(f"{csv_path}: row {skip}: the units row gives '{head.units[time_col]}' for the time "
                                f"column '{time_col}' but {side.name} says time_unit = '{meta['time_unit']}'; "
                                "allowed: the same unit in both")
-    cols = _load_columns(csv_path, head, ([time_col] if time_col else []) + list({**inputs, **outputs}))
+    cols = _load_columns(csv_path, text, head, ([time_col] if time_col else []) + list({**inputs, **outputs}))
     n = len(next(iter(cols.values())))
     if time_col:
         t_file = cols.pop(time_col) * TIME_UNITS[meta["time_unit"]]
@@ -257,7 +270,13 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
         if bad.size:
             raise MeasurementError(f"{csv_path}: row {skip + 1 + bad[0]}: column '{name}' is not finite "
                                    f"({bad.size} such value(s)); allowed: finite numbers")
-        values[name] = v * TO_SI[ch.unit]
+        with np.errstate(over="ignore"):
+            values[name] = v * TO_SI[ch.unit]
+        bad = np.flatnonzero(~(np.abs(values[name]) <= MAX_ABS_SI))
+        if bad.size:
+            raise MeasurementError(f"{csv_path}: row {skip + 1 + bad[0]}: column '{name}' = {v[bad[0]]:.6g} "
+                                   f"{ch.unit}, beyond {MAX_ABS_SI:.0e} in SI units; allowed: magnitudes up to "
+                                   f"{MAX_ABS_SI:.0e} (so that squares, sums and derivatives stay finite)")
     return Measurement(csv_path, meta["model"], t0 + np.arange(n) / fs, inputs, outputs, values, meta["level"],
                        meta["level_value"], dict(meta["excitation"]), meta["notes"])
 

@@ -5,7 +5,7 @@ import pathlib
 from dataclasses import dataclass, field
 
 from pyfit.analysis.excitation import Excitation, MultisineInput
-from pyfit.build.catalog import EXAMPLES
+from pyfit.catalog import EXAMPLES
 from pyfit.io.schema import ConfigError, check_bounds, check_numbers, check_sections, check_table, fail, read_toml
 
 METHODS = ("nno", "nno+polish", "ga", "de", "polish")
@@ -41,7 +41,7 @@ class ObjectiveChannel:
 
 @dataclass
 class NNOSettings:
-    """The seed's NNO settings (Tables 4.5, 5.2, 5.7)."""
+    """The thesis's NNO settings (Tables 4.5, 5.2, 5.7)."""
 
     init_sim: int = 20
     hidden_sizes: list[int] = field(default_factory=lambda: [15])

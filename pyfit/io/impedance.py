@@ -37,8 +37,8 @@ COLUMN = {"name": (str, True, None), "unit": (str, True, None)}
 
 @dataclass(frozen=True)
 class ImpedanceTest:
-    """A damper's measured clamp impedance: impedance[i, j] [N·s/m] (complex, force over velocity) at
-    frequencies[i] [Hz] and clamp displacement amplitude amplitudes[i, j] [m]."""
+    """A damper's measured clamp impedance: impedance[i, j] in N·s/m (complex, force over velocity) at
+    frequencies[i] in Hz and clamp displacement amplitude amplitudes[i, j] in m."""
 
     path: pathlib.Path
     frequencies: np.ndarray
@@ -95,7 +95,7 @@ def read_impedance(csv_path) -> ImpedanceTest:
 def write_impedance(csv_path, frequencies, amplitudes, impedance, notes: str = "",
                     uncertainty: float | None = None) -> pathlib.Path:
     """An impedance test file (CSV + sidecar) in the format read_impedance reads: one row per frequency [Hz]
-    and clamp amplitude amplitudes[i, j] [m], with the clamp velocity amplitude [m/s], |Z| [N·s/m], the phase
+    and clamp amplitude amplitudes[i, j] in m, with the clamp velocity amplitude [m/s], |Z| [N·s/m], the phase
     of Z [deg] and the mean power ½ Re Z ω² a² [W]; `uncertainty`: the stated relative error, if known."""
     csv_path = pathlib.Path(csv_path)
     f = np.repeat(np.asarray(frequencies, float)[:, None], np.shape(amplitudes)[1], axis=1)

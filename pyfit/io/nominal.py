@@ -1,5 +1,5 @@
 """The nominal model a user describes: which model family, the FMU parameters known from drawings (masses,
-inertias, arm lengths, mass offsets, clamp mass: design section 1 names, SI units), and the uncertain ones
+inertias, arm lengths, mass offsets, clamp mass: theory §1 names, SI units), and the uncertain ones
 with their start values and bounds (EI, Rayleigh coefficients, ...). A TOML file:
 
     [nominal]
@@ -12,7 +12,7 @@ with their start values and bounds (EI, Rayleigh coefficients, ...). A TOML file
     [nominal.free]                         # uncertain: start (optional: then the FMU default or the data) and bounds
     EI = { start = 10.0, lower = 3.0, upper = 30.0 }
 
-A parameter left out keeps the FMU's default (for the damper: the design section 1.3 reference damper,
+A parameter left out keeps the FMU's default (for the damper: the theory §1.3 reference damper,
 eccentric masses included). `free` without `start` starts from the data (SDOF: the measured FRF) or the
 FMU default.
 """

@@ -5,6 +5,7 @@ is read and checked here, and every error has one format:
 """
 from __future__ import annotations
 
+import codecs
 import pathlib
 import tomllib
 from typing import NoReturn
@@ -22,13 +23,34 @@ def fail(path, key: str, problem: str, allowed=None, error: type[ConfigError] = 
     raise error(msg)
 
 
-def read_toml(path, error: type[ConfigError] = ConfigError) -> dict:
-    """The parsed file; `error` names the file when it is missing or not valid TOML."""
+BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"), (codecs.BOM_UTF8, "utf-8-sig"),
+        (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"))
+TEXT_ALLOWED = "UTF-8 text (with or without a byte-order mark) or UTF-16/UTF-32 with a byte-order mark"
+
+
+def read_text(path, error: type[ConfigError] = ConfigError) -> str:
+    """A text file decoded by its byte-order mark (UTF-8, UTF-16, UTF-32), else as UTF-8; a binary or
+    undecodable file raises `error` naming the file, the byte offset and what is allowed."""
     path = pathlib.Path(path)
     if not path.is_file():
         raise error(f"{path}: file not found")
+    raw = path.read_bytes()
+    encoding = next((enc for bom, enc in BOMS if raw.startswith(bom)), None)
+    nul = raw.find(b"\x00")
+    if encoding in (None, "utf-8-sig") and nul >= 0:
+        raise error(f"{path}: a binary file (NUL byte at offset {nul}); allowed: {TEXT_ALLOWED}")
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
+        return raw.decode(encoding or "utf-8")
+    except UnicodeDecodeError as exc:
+        raise error(f"{path}: not {encoding or 'UTF-8'} text (byte offset {exc.start}: {exc.reason}); "
+                    f"allowed: {TEXT_ALLOWED}") from None
+
+
+def read_toml(path, error: type[ConfigError] = ConfigError) -> dict:
+    """The parsed file; `error` names the file when it is missing, not text or not valid TOML."""
+    text = read_text(path, error)
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise error(f"{path}: not valid TOML: {exc}") from exc
 

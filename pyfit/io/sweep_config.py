@@ -4,7 +4,7 @@ from __future__ import annotations
 import pathlib
 from dataclasses import dataclass, field
 
-from pyfit.build.catalog import EXAMPLES
+from pyfit.catalog import EXAMPLES
 from pyfit.io.schema import ConfigError, check_numbers, check_sections, check_table, fail, read_toml
 
 __all__ = ["ConfigError", "SweepConfig", "load_sweep"]

@@ -127,7 +127,7 @@ def _state_map(probe: _MEProbe, phys: list[str], t, inputs):
     return A, b
 
 
-# sampling scale of the candidate-effect parameters (design 6) in the right-hand-side check (SI units)
+# sampling scale of the candidate-effect parameters (theory §6) in the right-hand-side check (SI units)
 _EFFECT_SAMPLES = {"k3": 1e9, "F_c": 2.0, "c2": 10.0, "F_c1": 0.5, "F_c2": 0.5, "c2_1": 5.0, "c2_2": 5.0}
 
 

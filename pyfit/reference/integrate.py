@@ -83,7 +83,7 @@ def simulate_cvodes(model: ReferenceModel, t: np.ndarray, params: dict | None = 
 def simulate_newmark(model: ReferenceModel, t: np.ndarray, params: dict | None = None,
                      excitation: Excitation | None = None, inputs: dict | None = None,
                      a: float = 0.5, b: float = 0.25, c: float = 0.5, x0: np.ndarray | None = None) -> dict:
-    """The seed's Newmark scheme on the uniform grid t (its step is the grid spacing)."""
+    """The thesis's Newmark scheme on the uniform grid t (its step is the grid spacing)."""
     h = _check_grid(t)
     t = np.asarray(t, float)
     nq, nz = model.n_q, model.n_z

@@ -1,4 +1,4 @@
-"""Hand-written CasADi models of design section 1, independent of the Modelica sources.
+"""Hand-written CasADi models of theory §1, independent of the Modelica sources.
 
 Each model is a second-order system in first-order form with states [q (n_q), qdot (n_q), z (n_z)]:
 positions, velocities and first-order internal (hysteretic) variables. The right-hand side gives the
@@ -61,7 +61,7 @@ def _params(names):
 
 
 def bouc_wen_rate(v, z, alpha, beta, gamma, delta, nu):
-    """Classic Bouc-Wen law (design 1.1): dz/dt = alpha*v - beta*(gamma*|v|*|z|^(nu-1)*z + delta*v*|z|^nu)."""
+    """Classic Bouc-Wen law (theory §1.1): dz/dt = alpha*v - beta*(gamma*|v|*|z|^(nu-1)*z + delta*v*|z|^nu)."""
     az = ca.fabs(z) ** nu
     return alpha * v - beta * (gamma * ca.fabs(v) * ca.sign(z) * az + delta * v * az)
 
@@ -80,7 +80,7 @@ def sdof() -> ReferenceModel:
 
 
 def two_dof(config: str) -> ReferenceModel:
-    """TwoDOF system of design 1.2, configuration 'a'..'d'; force f on mass 1."""
+    """TwoDOF system of theory §1.2, configuration 'a'..'d'; force f on mass 1."""
     if config not in ("a", "b", "c", "d"):
         raise ValueError(f"TwoDOF configuration must be a, b, c or d, not {config!r}")
     names = list(TWO_DOF_DEFAULTS)
@@ -126,7 +126,7 @@ def damper_matrices(P) -> tuple[ca.SX, ca.SX]:
 
 
 def damper() -> ReferenceModel:
-    """Stockbridge damper on a shaker (design 1.3): clamp displacement, velocity, acceleration prescribed."""
+    """Stockbridge damper on a shaker (theory §1.3): clamp displacement, velocity, acceleration prescribed."""
     names = list(DAMPER_DEFAULTS)
     P, p = _params(names)
     q = ca.SX.sym("q", 4)  # x1, phi1, x2, phi2 (absolute)

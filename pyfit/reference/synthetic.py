@@ -1,9 +1,9 @@
 """Synthetic 'measured' data without the inverse crime.
 
-The truth is simulated by the independent CasADi reference (CVODES at tight tolerance, or the seed's
+The truth is simulated by the independent CasADi reference (CVODES at tight tolerance, or the thesis's
 Newmark scheme) at `oversample` times the sensor rate, passed through a sensor chain (zero-phase FIR
 anti-alias filter and decimation, or plain sampling as the Bouc-Wen benchmark did) and measurement noise,
-and written as a design-section-5 measurement. The model being fitted is the FMU (another
+and written as a measurement file (theory §5). The model being fitted is the FMU (another
 implementation and another integrator), sampled directly at the sensor rate.
 
 The excitation is a built-in one (sine, sweeps) or a measured force input: a random-phase multisine

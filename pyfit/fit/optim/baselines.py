@@ -50,7 +50,7 @@ class CountingResiduals:
 
 def ga_direct(residuals, n_var: int, budget: int, pop_size: int = 20, seed: int = 0,
               target: float | None = None) -> tuple[OptimResult, int | None]:
-    """The GA applied directly to the FMU objective (the seed's comparison). Returns the result and the
+    """The GA applied directly to the FMU objective (the thesis's comparison). Returns the result and the
     number of evaluations at which the error first reached `target` (None if never)."""
     from pymoo.algorithms.soo.nonconvex.ga import GA
     from pymoo.core.problem import ElementwiseProblem

@@ -1,4 +1,4 @@
-"""Neural Network Optimization (seed chapter 3, design section 4).
+"""Neural Network Optimization (thesis chapter 3, theory §4).
 
 (I) true evaluations at init_sim Sobol points; (II) train the MLP surrogate on all (x, residual vector);
 (III) minimise the surrogate's sum of squares with a GA (pymoo) warm-started from its previous
@@ -6,10 +6,10 @@ population; (IV) evaluate the FMU at the GA optimum; (V-VII) append, retrain, re
 latest true error < fun_tol, or when the relative change of x < x_tol and of the residual < y_tol
 (stall), or after max_sim true evaluations. Returns the best point ever evaluated.
 
-Two options beyond the seed, both off by default:
+Two options beyond the thesis, both off by default:
 - a search transform: the surrogate learns, and the GA and the trust region minimise, sum(g(r)^2) for a
   transform g of the residual vector, while the true errors recorded and the point returned are those of
-  sum(r^2). The seed's relative PSD error r = (P - P_meas)/P_meas spans 1e-3..1e4 across the bounds,
+  sum(r^2). The thesis's relative PSD error r = (P - P_meas)/P_meas spans 1e-3..1e4 across the bounds,
   which 20-60 samples cannot teach an MLP; g(r) = log1p(r) = log(P/P_meas) is smooth in the parameters
   and has the same minimiser where the model fits.
 - a trust region: the GA searches a box of half-width `radius` around the best point so far; the radius

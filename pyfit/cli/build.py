@@ -1,0 +1,32 @@
+"""stockbridge build: the Modelica library's examples as FMUs."""
+from __future__ import annotations
+
+import pathlib
+import sys
+
+from pyfit.catalog import EXAMPLES, LIBRARY
+
+EXAMPLE = """examples:
+  stockbridge build                       # every example into fmus/ (FMI 2.0) and fmus/fmi3/ (FMI 3.0)
+  stockbridge build StockbridgeDamper --out my_fmus
+  stockbridge build --library my_copy_of_the_library SDOFBoucWen"""
+
+
+def add_arguments(ap) -> None:
+    """Arguments of `stockbridge build`."""
+    ap.add_argument("names", nargs="*", help=f"examples to build (default: all of {', '.join(EXAMPLES)})")
+    ap.add_argument("--out", default="fmus", help="output folder (default: fmus)")
+    ap.add_argument("--library", default=str(LIBRARY), help="Modelica library folder (default: the package's)")
+
+
+def run(args, ap) -> int:
+    """Build the FMUs, one line per FMU."""
+    from pyfit.build import ModelicaError, build_all
+
+    try:
+        build_all(pathlib.Path(args.out), args.names or None, pathlib.Path(args.library),
+                  on_built=lambda r: print(f"built {r.fmu} and {r.fmu3} ({r.n_states} states)"))
+    except (ModelicaError, ValueError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    return 0

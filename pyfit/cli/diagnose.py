@@ -1,0 +1,84 @@
+"""stockbridge diagnose: where the nominal model misfits a measured dataset, which candidate effect explains
+it, and how far the misfit shrinks on held-out files once that effect is added."""
+from __future__ import annotations
+
+import json
+import pathlib
+import sys
+
+EXAMPLE = """examples:
+  stockbridge diagnose --model damper --data my_sweeps/ --nominal my_damper.toml --out results/diagnose
+  stockbridge diagnose --model sdof --data my_tests/
+  stockbridge diagnose --impedance damper_test.csv --uncertainty 0.01      # an IEC 61897 impedance test
+  stockbridge diagnose --make-datasets cases/ --excitation sweep --record a # withheld-effect test cases
+  stockbridge diagnose --cases cases/ --out results/cases                   # every dataset under cases/
+  stockbridge diagnose --benchmark --config configs/diagnose_benchmark.toml # official Bouc-Wen signals
+
+A dataset is a folder of measurement files (CSV + TOML sidecar, one per level; docs: measurement files).
+Writes report.md (verdict, ranked effects, shrink on held-out files), report.json and figures into --out."""
+
+
+def add_arguments(ap) -> None:
+    """Arguments of `stockbridge diagnose`."""
+    ap.add_argument("--model", default="sdof", help="nominal model: sdof (linear SDOF) or damper (linear FE damper)")
+    ap.add_argument("--data", help="dataset folder (CSV + TOML pairs)")
+    ap.add_argument("--config", help="TOML with a [diagnose] table")
+    ap.add_argument("--nominal", help="TOML describing your system: [nominal] family, fixed and free parameters "
+                                      "(default: the FMU's own; for the damper the reference damper)")
+    ap.add_argument("--out", default="results/diagnose")
+    ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument("--fmus", default="fmus")
+    ap.add_argument("--make-datasets", metavar="DIR", help="write the withheld-effect datasets of --model into DIR")
+    ap.add_argument("--benchmark", action="store_true",
+                    help="use the official Bouc-Wen benchmark signals (written as a dataset into OUT/data)")
+    ap.add_argument("--cases", metavar="DIR", help="diagnose every dataset folder under DIR and write summary.md")
+    ap.add_argument("--impedance", metavar="TEST.csv", help="diagnose a damper's impedance test (CSV + TOML "
+                    "sidecar, kind = damper_impedance) at three or more clamp-velocity levels")
+    ap.add_argument("--uncertainty", type=float, help="with --impedance: the test's relative measurement error "
+                    "(RMS of |Z_meas/Z_true - 1|; default: `uncertainty` of the test's sidecar)")
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2], help="noise seeds of the null cases")
+    ap.add_argument("--excitation", choices=["multisine", "sweep", "impedance"], default="multisine",
+                    help="with --make-datasets: steady multisine periods, a 35 s sweep from rest, or (--model "
+                         "damper) an impedance test")
+    ap.add_argument("--record", nargs="+", metavar="OUTPUT", help="with --make-datasets: the outputs recorded "
+                    "(default: displacements; e.g. a, or acc_x1 acc_x2)")
+    ap.add_argument("--motion", default="xva", help="with --make-datasets --model damper: which of the clamp's "
+                                                    "x, v, a are recorded (e.g. x)")
+
+
+def run(args, ap) -> int:
+    """Dispatch to the dataset writer, the case runner, the impedance or the measurement diagnosis."""
+    from pyfit.gap import cases, datasets
+    from pyfit.gap.diagnose import diagnose, load_config
+    from pyfit.gap.impedance_gap import diagnose_impedance
+    from pyfit.io import benchmark_data
+    from pyfit.io.nominal import load_nominal
+    from pyfit.io.schema import ConfigError
+
+    try:
+        if args.make_datasets:
+            style = datasets.LabStyle(args.excitation, tuple(args.record) if args.record else None, args.motion)
+            base = load_nominal(args.nominal).fixed if args.nominal else None  # uncertain ones: FMU defaults
+            for path in datasets.write_cases(args.make_datasets, args.model, args.seeds, style=style, base=base):
+                print(path)
+            return 0
+        cfg = load_config(args.config) if args.config else None
+        if args.cases:
+            cases.run_cases(args.cases, args.out, cfg, args.model, args.fmus, args.workers, args.nominal)
+            print((pathlib.Path(args.out) / "summary.md").read_text())
+            return 0
+        if args.impedance:
+            report = diagnose_impedance(args.impedance, args.out, cfg, args.fmus, args.nominal, args.uncertainty,
+                                        args.workers)
+        else:
+            if args.benchmark:
+                args.data = benchmark_data.write_dataset(pathlib.Path(args.out) / "data")
+            if not args.data:
+                ap.error("--data is required (or --impedance, --benchmark, --make-datasets, --cases)")
+            report = diagnose(args.model, args.data, args.out, cfg, args.fmus, args.workers, nominal=args.nominal)
+    except (ConfigError, ValueError, FileNotFoundError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(json.dumps({k: report[k] for k in ("verdict", "chosen_effect")}, indent=1))
+    print(f"report: {pathlib.Path(args.out) / 'report.md'}")
+    return 0
