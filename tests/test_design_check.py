@@ -205,8 +205,10 @@ def test_span_config_errors_name_the_key(tmp_path):
 
 def test_design_check_command_writes_the_report(fmu_dir, tmp_path):
     span = tmp_path / "span.toml"
-    small = {"n_amplitudes = 14": "n_amplitudes = 3", "n_frequencies = 20": "n_frequencies = 2",
-             "max_dampers = 2": "max_dampers = 1", "step = 0.25": "step = 0.5"}  # a quick version of the example
+    # a quick version of the example; the damper without its softening springs stays stable at every clamp
+    # amplitude of the table, so that every configuration resolves
+    small = {"n_amplitudes = 14": "n_amplitudes = 3\nparameters = { k_cs1 = 0.0, k_cs2 = 0.0 }",
+             "n_frequencies = 20": "n_frequencies = 2", "max_dampers = 2": "max_dampers = 1", "step = 0.25": "step = 0.5"}
     text = (ROOT / "configs" / "span_drake_300m.toml").read_text()
     for old, new in small.items():
         assert old in text

@@ -85,8 +85,9 @@ static inline double pyfit_pow(double x, double y) { return y == 1.0 ? x : y == 
 
 
 def casadi_functions(model: ExplicitModel, ident: str) -> list[ca.Function]:
-    """The functions the wrapper calls, for each variant: ode, vars, jac (dense, column-major) and hoist,
-    plus calc.
+    """The functions the wrapper calls, for each variant: ode, vars, jac and hoist, plus calc. `jac` is the
+    forward-mode directional derivative d(xdot, vars) = J · s for a seed s over (states, inputs): its code grows
+    like the model's, where a dense Jacobian's grows with (states + inputs) times it.
 
     Variant "" is the general model; variant "_s" (only for models with the parameter exc_type) has
     exc_type = 0 substituted, so a run driven by sampled inputs does not evaluate the built-in excitation's
@@ -107,14 +108,16 @@ def casadi_functions(model: ExplicitModel, ident: str) -> list[ca.Function]:
         variants["_s"] = model.p[pnames.index(SAMPLED_SWITCH)]
     for suffix, switch in variants.items():
         xdot, var = (model.xdot, allv) if switch is None else (ca.substitute(e, switch, 0) for e in (model.xdot, allv))
-        jac = ca.densify(ca.jacobian(ca.vertcat(xdot, var), ca.vertcat(model.x, model.u)))
+        known = ca.vertcat(model.x, model.u)
+        seed = ca.SX.sym("s", known.numel())
+        jac = ca.jtimes(ca.vertcat(xdot, var), known, seed)
         (xdot, var, jac), symbols, parametric = ca.extract_parametric([xdot, var, jac], model.p)
         h = ca.vertcat(*symbols) if symbols else ca.SX(0, 1)
         functions += [ca.Function(f"{ident}_hoist{suffix}", [model.p],
                                   [ca.vertcat(*parametric) if parametric else ca.SX(0, 1)], ["p"], ["h"]),
                       ca.Function(f"{ident}_ode{suffix}", args + [h], [xdot], names, ["xdot"]),
                       ca.Function(f"{ident}_vars{suffix}", args + [h], [var], names, ["v"]),
-                      ca.Function(f"{ident}_jac{suffix}", args + [h], [jac], names, ["J"])]
+                      ca.Function(f"{ident}_jac{suffix}", args + [h, seed], [jac], names + ["s"], ["dv"])]
     return functions
 
 

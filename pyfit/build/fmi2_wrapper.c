@@ -78,7 +78,8 @@ typedef struct {
   double xscale[ARRSZ(N_STATES)];
   double utmp[ARRSZ(N_INPUTS)];
   double h_last;
-  double jacobian[ARRSZ(N_OUT * N_XU)];
+  double seed[ARRSZ(N_XU)];       /* directional derivative: the seed over (states, inputs) ... */
+  double jacobian[ARRSZ(N_OUT)];  /* ... and J · seed over (state derivatives, variables) */
 } Instance;
 
 static void logmsg(Instance *c, fmi2Status st, const char *fmt, ...) {
@@ -121,7 +122,7 @@ static int allowed(Instance *c, int mask, int only, const char *fn) {
 
 /* ---- calls into the generated functions ----------------------------------------------------- */
 static int call_model(Instance *c, ModelFunction f, const double *x, const double *u, const double *t, double *out) {
-  c->arg[0] = x; c->arg[1] = u; c->arg[2] = c->v; c->arg[3] = t; c->arg[4] = c->hoist;
+  c->arg[0] = x; c->arg[1] = u; c->arg[2] = c->v; c->arg[3] = t; c->arg[4] = c->hoist; c->arg[5] = c->seed;
   c->res[0] = out;
   return f(c->arg, c->res, c->iw, c->w, 0);
 }
@@ -497,21 +498,25 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2ValueRefer
   GUARD(LIVE, 0, "fmi2GetDirectionalDerivative");
   t = c->time;
   if (update_calculated(c)) return fmi2Error;
+  /* one forward-mode sweep: J · seed, the seed holding dvKnown at the knowns' positions */
+  for (j = 0; j < N_XU; j++) c->seed[j] = 0.0;
+  for (j = 0; j < nK; j++) {
+    long col;
+    if (vKnown[j] >= OFS_STATE && vKnown[j] < OFS_DER) col = (long)(vKnown[j] - OFS_STATE);
+    else if (vKnown[j] >= OFS_INPUT && vKnown[j] < OFS_STATE) col = N_STATES + (long)(vKnown[j] - OFS_INPUT);
+    else { logmsg(c, fmi2Error, "value reference %u is not a known", (unsigned)vKnown[j]); return fmi2Error; }
+    c->seed[col] += dvKnown[j];
+  }
+  for (i = 0; i < nU; i++) {
+    if (!((vUnknown[i] >= OFS_DER && vUnknown[i] < OFS_VAR) || (vUnknown[i] >= OFS_VAR && vUnknown[i] < N_TOTAL))) {
+      logmsg(c, fmi2Error, "value reference %u is not an unknown", (unsigned)vUnknown[i]);
+      return fmi2Error;
+    }
+  }
   if (call_model(c, c->jac, c->v + OFS_STATE, c->v + OFS_INPUT, &t, c->jacobian)) return fmi2Error;
   for (i = 0; i < nU; i++) {
-    long row;
-    if (vUnknown[i] >= OFS_DER && vUnknown[i] < OFS_VAR) row = (long)(vUnknown[i] - OFS_DER);
-    else if (vUnknown[i] >= OFS_VAR && vUnknown[i] < N_TOTAL) row = N_STATES + (long)(vUnknown[i] - OFS_VAR);
-    else { logmsg(c, fmi2Error, "value reference %u is not an unknown", (unsigned)vUnknown[i]); return fmi2Error; }
-    dvUnknown[i] = 0.0;
-    for (j = 0; j < nK; j++) {
-      long col;
-      if (vKnown[j] >= OFS_STATE && vKnown[j] < OFS_DER) col = (long)(vKnown[j] - OFS_STATE);
-      else if (vKnown[j] >= OFS_INPUT && vKnown[j] < OFS_STATE) col = N_STATES + (long)(vKnown[j] - OFS_INPUT);
-      else { logmsg(c, fmi2Error, "value reference %u is not a known", (unsigned)vKnown[j]); return fmi2Error; }
-      /* CasADi stores dense matrices column-major */
-      dvUnknown[i] += c->jacobian[col * N_OUT + row] * dvKnown[j];
-    }
+    long row = vUnknown[i] < OFS_VAR ? (long)(vUnknown[i] - OFS_DER) : N_STATES + (long)(vUnknown[i] - OFS_VAR);
+    dvUnknown[i] = c->jacobian[row];
   }
   return fmi2OK;
 }

@@ -121,7 +121,7 @@ def write_report(result: DesignResult, out_dir) -> pathlib.Path:
     verdict = "PASSES" if fat["passes"] else "FAILS"
     damper = (f"measured impedance `{d.impedance_file.name}`" if d.impedance_file else "DamperElement FMU" + (
         " with " + ", ".join(f"{k} = {v:g}" for k, v in sorted(d.damper_parameters.items()))
-        if d.damper_parameters else " (theory §1.3 defaults)"))
+        if d.damper_parameters else " (the reference damper of theory §1.3)"))
     lines = [f"# Span design check: {c.name}, {d.length:g} m at {d.tension / 1e3:.1f} kN ({d.tension / c.rts:.0%} RTS)", "",
              f"**The span {verdict} with {len(result.recommended.positions)} damper(s) at {_positions(result.recommended)} "
              f"from the suspension clamp: the worst fatigue use is {1 - fat['margin']:.2f} of the limit, a margin of "

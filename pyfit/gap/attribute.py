@@ -51,6 +51,7 @@ class FitTask:
     threads: int = 1  # records simulated at once (one FMU instance each; the compiled loop releases the GIL)
     continuation: bool = True  # envelopes first, then the lowest level, then all (see run_fit)
     log_scaled: tuple = ()  # free parameters scaled to their bounds on a log scale (positive, spanning decades)
+    floor: dict | None = None  # a point the result must not be worse than (the nominal: the effect at zero)
 
 
 class UnitScaling:
@@ -131,10 +132,16 @@ def run_fit(task: FitTask) -> Fit:
         used, budget = used + 1 + stage.n_evaluations, budget - stage.n_evaluations
     # least squares from there; it returns the best point it evaluated, so never worse than its start
     result = polish(lambda x: residuals(params(x)), x0, budget=budget)
-    best = params(result.x)
+    best, error = params(result.x), result.error
+    if task.floor is not None:  # never worse than the nominal model (the effect at zero)
+        floor = {**task.fixed, **task.floor}
+        e = float(np.sum(residuals(floor) ** 2))
+        used += 1
+        if e < error:
+            best, error = floor, e
     # the stacked residual's sum of squares is the weighted sum of every channel's squared NRMSE
     channels = sum(sum(r.weights.get(k, 1.0) for k in r.outputs) for r in task.records)
-    err = float(np.sqrt(result.error / channels))
+    err = float(np.sqrt(error / channels))
     for r in runner if isinstance(runner, list) else [runner]:
         r.close()
     if pool:
@@ -193,16 +200,16 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
     can be far from it)."""
     start, bounds, fixed = effect_start(system, effect, scale, nominal.params)
     strengths = [{}] + [{n: v * f for n, v in strength.items()} for f in STRENGTH_FACTORS] if strength else [{}]
-    # the effect at zero is the calibrated nominal: with it among the starts, a refit never ends worse than it
-    alternatives = [{**{n: nominal.params[n] for n in system.linear}, **effect.absent(scale)}]
-    alternatives += [s for s in strengths if s]
+    alternatives = [s for s in strengths if s]
     for linear in linear_starts:
         lin_start, lin_bounds, _ = effect_start(system, effect, scale, nominal.params, linear)
         bounds = {n: (min(bounds[n][0], lin_bounds[n][0]), max(bounds[n][1], lin_bounds[n][1])) for n in bounds}
         alternatives += [{**{n: lin_start[n] for n in system.linear}, **s} for s in strengths]
+    # the effect at zero is the calibrated nominal: the refit keeps it when it ends worse than that
+    floor = {**{n: nominal.params[n] for n in system.linear}, **effect.absent(scale)}
     return FitTask(fmu, tuple(records), {**system.nominal_fixed, **fixed}, start, bounds, effect.name,
                    len(effect.params), budget, upsample, system.lead_periods, tuple(alternatives),
-                   log_scaled=tuple(p.name for p in effect.params if p.shape))
+                   log_scaled=tuple(p.name for p in effect.params if p.shape), floor=floor)
 
 
 def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int, effects: list,
