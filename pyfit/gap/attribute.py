@@ -24,7 +24,7 @@ class Fit:
     effect: str  # "nominal" or the effect's name
     params: dict  # every FMU parameter set (SI)
     free: list  # names of the fitted ones
-    n_added: int  # parameters the effect adds to the nominal model
+    n_added: int  # strength parameters the effect adds to the nominal model (shape parameters not counted)
     calibration_nrmse: float
     evaluations: int
     wall_s: float
@@ -191,25 +191,29 @@ def effect_start(system: System, effect: Effect, scale: Scale, nominal: dict, li
 
 
 def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal: Fit, scale: Scale,
-                budget: int, upsample: int, strength: dict | None = None, linear_starts: tuple = ()) -> FitTask:
-    """The refit of the nominal model with `effect` added, from the best of the effect's default start and
-    the screening's Gauss-Newton `strength` (parameter -> value) scaled by STRENGTH_FACTORS (the step
-    linearises an effect that is not linear in its strength: it can overshoot), each with the calibrated
-    nominal's linear parameters and with each of `linear_starts` (e.g. the linear system estimated from the
-    lowest level, where an amplitude-dependent effect is weakest: the nominal's compromise over all levels
-    can be far from it)."""
+                budget: int, upsample: int, strength: dict | None = None, linear_starts: tuple = (),
+                seeds: tuple = ()) -> FitTask:
+    """The refit of the nominal model with `effect` added, from the best of: the effect's default start; its
+    other shape starts (effect.starts: loop shapes spanning the family); the screening's Gauss-Newton
+    `strength` (parameter -> value) scaled by STRENGTH_FACTORS (the step linearises an effect that is not
+    linear in its strength: it can overshoot), each with the calibrated nominal's linear parameters and with
+    each of `linear_starts` (e.g. the linear system estimated from the lowest level, where an
+    amplitude-dependent effect is weakest: the nominal's compromise over all levels can be far from it); and
+    `seeds` (parameter values of earlier fits, e.g. each member's own refit for a combination)."""
     start, bounds, fixed = effect_start(system, effect, scale, nominal.params)
     strengths = [{}] + [{n: v * f for n, v in strength.items()} for f in STRENGTH_FACTORS] if strength else [{}]
-    alternatives = [s for s in strengths if s]
+    alternatives = [s for s in strengths if s] + list(effect.starts(scale))
     for linear in linear_starts:
         lin_start, lin_bounds, _ = effect_start(system, effect, scale, nominal.params, linear)
         bounds = {n: (min(bounds[n][0], lin_bounds[n][0]), max(bounds[n][1], lin_bounds[n][1])) for n in bounds}
         alternatives += [{**{n: lin_start[n] for n in system.linear}, **s} for s in strengths]
+    for seed in seeds:  # clipped into the bounds by the unit scaling
+        alternatives.append({n: seed[n] for n in start if n in seed})
     # the effect at zero is the calibrated nominal: the refit keeps it when it ends worse than that
     floor = {**{n: nominal.params[n] for n in system.linear}, **effect.absent(scale)}
     return FitTask(fmu, tuple(records), {**system.nominal_fixed, **fixed}, start, bounds, effect.name,
-                   len(effect.params), budget, upsample, system.lead_periods, tuple(alternatives),
-                   log_scaled=tuple(p.name for p in effect.params if p.shape), floor=floor)
+                   effect.strengths, budget, upsample, system.lead_periods, tuple(alternatives),
+                   log_scaled=tuple(p.name for p in effect.params if p.log), floor=floor)
 
 
 def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int, effects: list,

@@ -91,30 +91,34 @@ class LabStyle:
     sweep_s: float = 35.0
 
 
-def _truth_params(family: Family, effect: str, base: dict) -> dict:
-    """Truth = linear + base (a described system) + the effect; an effect value may be a function of the
-    system's parameters (a deviation from them, e.g. mass offsets)."""
+def _truth_params(family: Family, effect: str, base: dict, truth: dict | None = None) -> dict:
+    """Truth = linear + base (a described system) + the effect(s) ('a+b': several), or + `truth` when given
+    (e.g. parameters drawn at random across the family); an effect value may be a function of the system's
+    parameters (a deviation from them, e.g. mass offsets)."""
     from pyfit.reference.models import by_name
 
     system = {**by_name(family.model).defaults, **family.linear, **base}
-    extra = {k: (v(system) if callable(v) else v) for k, v in family.withheld[effect].items()}
+    if truth is None:
+        truth = {k: v for name in effect.split("+") for k, v in family.withheld[name].items()}
+    extra = {k: (v(system) if callable(v) else v) for k, v in truth.items()}
     return {**family.linear, **base, **extra}
 
 
 def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: int = PERIODS,
-                  style: LabStyle = LabStyle(), base: dict | None = None) -> pathlib.Path:
+                  style: LabStyle = LabStyle(), base: dict | None = None, truth: dict | None = None) -> pathlib.Path:
     """Write one dataset (a file per level) whose truth has `effect` ('none' for a null case), as recorded in
     `style`, of the system `base` (FMU parameter overrides, e.g. a described damper; None: the defaults);
     truth.json beside it records the truth and what the effect changes at each level against the truth
     without it (Bouc-Wen as its tangent stiffness): the output RMS (RMS(y)/RMS(y_tangent) - 1) and the
     output itself (RMS(y - y_tangent)/RMS(y_tangent)); the diagnosis never reads it."""
-    if effect not in family.withheld:
-        raise ValueError(f"effect '{effect}' unknown for {family.model}; allowed: {', '.join(family.withheld)}")
+    if truth is None and any(e not in family.withheld for e in effect.split("+")):
+        raise ValueError(f"effect '{effect}' unknown for {family.model}; allowed: {', '.join(family.withheld)} "
+                         "(or several joined by '+', or the truth's parameters given)")
     if style.excitation not in ("multisine", "sweep"):
         raise ValueError(f"excitation '{style.excitation}' unknown; allowed: multisine, sweep")
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    truth = _truth_params(family, effect, base or {})
+    truth = _truth_params(family, effect, base or {}, truth)
     recorded = tuple(style.outputs or family.outputs)
     spp, fs, lead = family.samples_per_period, family.fs, family.lead_periods
     rng = np.random.default_rng(seed)

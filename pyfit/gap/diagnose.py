@@ -7,6 +7,7 @@ import hashlib
 import json
 import os
 import pathlib
+import dataclasses
 from dataclasses import asdict, dataclass, fields
 
 
@@ -17,10 +18,10 @@ from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
 from pyfit.runtime.examples import ensure_fmu
 from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read_toml
-from pyfit.gap import localise
+from pyfit.gap import localise, selection
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import Fit, effect_task, nominal_task, run_fit, screen
-from pyfit.gap.systems import family_fmu, make_system
+from pyfit.gap.systems import combine, family_fmu, make_system
 from pyfit.io.nominal import NominalModel, load_nominal
 
 
@@ -46,10 +47,14 @@ class DiagnoseConfig:
     explain_factor: float = 3.0  # ... and bring the held-out NRMSE within explain_factor x the noise floor
     explain_margin: float = 0.02  # ... or within the floor + explain_margin (the absolute criterion)
     nominal_max_nrmse: float = 0.8  # a nominal whose NRMSE on its best calibration file exceeds this "does not fit"
+    max_effects: int = 2  # effects combined at most when no single one explains the gap (forward selection)
+    partners: int = 3  # candidates tried as the next member of a combination (the best single refits)
+    min_gain: float = 5.0  # score points a larger combination must gain to be kept
 
 
 _SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
-                   int if f.name in ("nominal_budget", "refit_budget", "upsample") else "number"), False, f.default)
+                   int if f.name in ("nominal_budget", "refit_budget", "upsample", "max_effects", "partners")
+                   else "number"), False, f.default)
          for f in fields(DiagnoseConfig)}
 
 
@@ -140,6 +145,69 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
     return None
 
 
+def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, scale, fits: dict, sims: dict, gap,
+                  runner, out: pathlib.Path, key: str, workers, progress):
+    """Forward selection when no single effect explains the held-out gap: add to the best model so far each of
+    the `cfg.partners` best-scoring other effects, refit jointly (from each member's own refit and the effects'
+    starts), and keep the best combination while it gains `cfg.min_gain` score points, up to `cfg.max_effects`
+    members or until it explains the gap. Adds the combinations' fits and held-out simulations to `fits` and
+    `sims`; returns the system with the combined effects among its effects, and the model selected (a single
+    effect or a combination; None when nothing was tried)."""
+    before, floor = gap["overall"], gap["noise_floor"]
+    explained_below = max(cfg.explain_factor * floor, floor + cfg.explain_margin)
+    scores = {n: selection.score(before, selection.heldout_nrmse(sims[n], held), floor, f.n_added)
+              for n, f in fits.items()}
+    ranked = sorted(scores, key=lambda n: -scores[n])
+    if not ranked or selection.heldout_nrmse(sims[ranked[0]], held) <= explained_below:
+        return system, None
+    effects = dict(system.effects)
+    current = ranked[0]
+    while len(effects[current].members or (current,)) < cfg.max_effects:
+        members = list(effects[current].members or (current,))
+        # the model so far, refitted on from its own result with a combination's budget: a combination must
+        # beat more evaluations of its first member(s), not only the first refit
+        again_path = out / "fits" / f"{current.replace(' + ', '+')}.continued.json"
+        again = _stored(again_path, key)
+        jobs = [] if again else [(effect_task(system, effects[current], fmu, cal, nominal, scale, cfg.refit_budget,
+                                              cfg.upsample, seeds=(fits[current].params,)), str(again_path), key)]
+        names = []
+        for partner in [n for n in ranked if n not in members and n in system.effects][:cfg.partners]:
+            combo = combine([system.effects[m] for m in members + [partner]])
+            effects[combo.name] = combo
+            path = out / "fits" / f"{combo.name.replace(' + ', '+')}.json"
+            fits[combo.name] = _stored(path, key)
+            names.append(combo.name)
+            if fits[combo.name] is None:
+                seeds = (fits[current].params, {**fits[current].params, **{
+                    p.name: fits[partner].params[p.name] for p in system.effects[partner].params}})
+                jobs.append((effect_task(system, combo, fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
+                                         seeds=seeds), str(path), key))
+        for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="combinations"):
+            if fit.effect == current:
+                again = fit
+            else:
+                fits[fit.effect] = fit
+        if again.calibration_nrmse < fits[current].calibration_nrmse:
+            fits[current] = again
+            sims[current] = {r.name: sim.simulate(runner, r, again.params, cfg.upsample, system.lead_periods)
+                             for r in held}
+            scores[current] = selection.score(before, selection.heldout_nrmse(sims[current], held), floor,
+                                              again.n_added)
+        for name in names:
+            sims[name] = {r.name: sim.simulate(runner, r, fits[name].params, cfg.upsample, system.lead_periods)
+                          for r in held}
+            scores[name] = selection.score(before, selection.heldout_nrmse(sims[name], held), floor,
+                                           fits[name].n_added)
+        best = max(names, key=lambda n: scores[n], default=None)
+        if (best is None or scores[best] < scores[current] + cfg.min_gain
+                or selection.heldout_nrmse(sims[current], held) <= explained_below):
+            break
+        current = best
+        if selection.heldout_nrmse(sims[current], held) <= explained_below:
+            break
+    return dataclasses.replace(system, effects=effects), current
+
+
 def fmu_defaults(runner: FmuRunner) -> dict[str, float]:
     """The FMU's parameter start values (the .mo defaults), SI."""
     return {v.name: float(v.start) for v in runner.model_description.modelVariables
@@ -179,7 +247,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)
     judging = ("min_gap", "noise_factor", "close_points", "min_shrink_pct", "explain_factor", "explain_margin",
-               "nominal_max_nrmse")  # how results are judged, not how fits are made: stored fits stay valid
+               "nominal_max_nrmse", "max_effects", "partners", "min_gain")  # how results are judged and which
+    # combinations are tried, not how a fit is made: stored fits stay valid
     settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in judging}, sort_keys=True)
     description = json.dumps({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}
                              if described else {}, sort_keys=True)
@@ -205,7 +274,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     bands = [tuple(b) for b in cfg.bands_hz] if cfg.bands_hz else localise.default_bands(records)
     gap = report.nominal_gap(sims["nominal"], records, held, bands, cfg)
     clock.end("where (nominal gap)")
-    screening, fits = {}, {}
+    screening, fits, selected = {}, {}, None
     effects = cfg.effects or list(system.effects)
     # nothing to attribute when the nominal model fits the held-out files within their noise, or fits none of
     # its own calibration files
@@ -235,7 +304,11 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
             sims[name] = {r.name: sim.simulate(runner, r, f.params, cfg.upsample, system.lead_periods)
                           for r in held}
         clock.end("refits with each effect")
-    result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap)
+        system, selected = _combinations(system, cfg, fmu, cal, held, nominal, scale, fits, sims, gap, runner, out,
+                                         key, workers, progress)
+        clock.end("combinations of effects")
+    result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
+                             selected)
     result["level_order"] = level_order
     result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample, system.lead_periods)
     runner.close()

@@ -200,14 +200,14 @@ def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu
             e_start, e_bounds, e_fixed = effect_start(system, effect, scale, nominal_fit.params)
             free[name], stored = list(e_start), _stored(path, key)
             if stored:
-                fits[name] = judged(name, stored[0], free[name], len(effect.params), stored[1])
+                fits[name] = judged(name, stored[0], free[name], effect.strengths, stored[1])
                 continue
-            tries = [{**e_start, **s} for s in _strength_starts(effect, scale)]
+            tries = [{**e_start, **s} for s in _strength_starts(effect, scale) + effect.starts(scale)]
             jobs.append(((fmu, cal, {**system.nominal_fixed, **e_fixed}, tries, e_bounds,
-                          tuple(p.name for p in effect.params if p.shape), cfg.refit_budget), path, key))
+                          tuple(p.name for p in effect.params if p.log), cfg.refit_budget), path, key))
         for job, (params, n_eval) in zip(jobs, map_tasks(_fit_and_store, jobs, workers, progress=False)):
             name = job[1].stem
-            fits[name] = judged(name, params, free[name], len(system.effects[name].params), n_eval)
+            fits[name] = judged(name, params, free[name], system.effects[name].strengths, n_eval)
     ranking = []
     # the reference of the shrink: the stated uncertainty, or the best held-out misfit if smaller
     reference = min([floor] + [fit.heldout_error for fit in fits.values()])

@@ -186,14 +186,24 @@ def by_loop_region(sim: dict, rec: Record) -> dict[str, float]:
     return {r: float(np.sqrt(v)) for r, v in out.items()}
 
 
+EXCITED_ENERGY = 0.998  # share of the input's spectral energy the excited range holds (non-periodic records)
+
+
 def excited_range(records: list[Record]) -> tuple[float, float]:
-    """Lowest and highest frequency [Hz] the records' inputs excite (DFT lines above 1e-3 of the peak)."""
+    """Lowest and highest frequency [Hz] the records' inputs excite: the DFT lines above 1e-3 of the peak, and
+    for a record that is not periodic (a sweep or noise, whose start and end leak energy to every line) the
+    band that holds EXCITED_ENERGY of the input's energy."""
     lo, hi = np.inf, 0.0
     for rec in records:
         u = rec.compared(next(iter(rec.inputs)))
         U = np.abs(np.fft.rfft(u))
         f = np.fft.rfftfreq(len(u), 1.0 / rec.fs)
-        exc = f[(U > 1e-3 * U.max()) & (f > 0)]
+        on = (U > 1e-3 * U.max()) & (f > 0)
+        if not rec.periodic:
+            cum = np.cumsum(np.where(f > 0, U**2, 0.0))
+            tail = (1.0 - EXCITED_ENERGY) / 2 * cum[-1]
+            on &= (cum >= tail) & (cum <= cum[-1] - tail)
+        exc = f[on]
         lo, hi = min(lo, exc.min()), max(hi, exc.max())
     return float(lo), float(hi)
 

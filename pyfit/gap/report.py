@@ -8,7 +8,7 @@ import pathlib
 import numpy as np
 
 from pyfit.report import plots
-from pyfit.gap import localise
+from pyfit.gap import localise, selection
 from pyfit.gap import simulate as sim
 
 
@@ -44,7 +44,7 @@ def _gap(sims: dict, records, held, bands, floors: dict) -> dict:
 
 def _free_values(fit) -> dict:
     out = {n: fit.params[n] for n in fit.free}
-    if fit.effect == "hysteresis" and "gamma" in fit.free:
+    if "hysteresis" in fit.effect.split(" + ") and "delta" in fit.free:  # the SDOF form: β·γ, β·δ identifiable
         out["beta (fixed)"] = fit.params["beta"]
         out["beta*gamma"] = fit.params["beta"] * fit.params["gamma"]
         out["beta*delta"] = fit.params["beta"] * fit.params["delta"]
@@ -75,13 +75,12 @@ def best_calibration_nrmse(gap: dict) -> tuple[float, str]:
     return (best["nrmse"], best["file"]) if best else (float("inf"), "")
 
 
-def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap) -> dict:
-    """The report: verdict, chosen effect, gap (where), ranking (which, how far), evidence."""
+def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
+             selected: str | None = None) -> dict:
+    """The report: verdict, chosen effect, gap (where), ranking (which, how far), evidence. `selected`: the
+    model the forward selection kept; the other combinations it tried are reported but not chosen."""
     floor, before, significant = gap["noise_floor"], gap["overall"], gap["significant"]
-    afters = {}
-    for name in fits:
-        done = [localise.nrmse(sims[name][r.name], r) for r in held if sims[name][r.name] is not None]
-        afters[name] = _rms_over(done) if len(done) == len(held) else float("inf")
+    afters = {name: selection.heldout_nrmse(sims[name], held) for name in fits}
     # the floor is an upper bound where distortion counts as noise (localise.UPPER_BOUNDS); so is any model's
     # held-out misfit: the shrink is measured against the smaller of the two
     reference = min([floor] + list(afters.values()))
@@ -89,17 +88,29 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
     ranking = []
     for name, fit in fits.items():
         after = afters[name]
-        shrink = 100.0 * (before - after) / (before - reference) if before > reference else 0.0
-        ranking.append({"effect": name, "score": shrink - 5.0 * (fit.n_added - 1), "heldout_gap_before": before,
-                        "heldout_gap_after": after, "shrink_pct": shrink, "params": _free_values(fit),
+        members = list(system.effects[name].members) if name in system.effects else []
+        ranking.append({"effect": name, "members": members or [name],
+                        "score": selection.score(before, after, reference, fit.n_added),
+                        "heldout_gap_before": before, "heldout_gap_after": after,
+                        "shrink_pct": selection.shrink_pct(before, after, reference), "params": _free_values(fit),
                         "n_added_params": fit.n_added, "screening_explained": screening.get(name),
                         "calibration_nrmse": fit.calibration_nrmse, "evaluations": fit.evaluations,
                         "wall_s": fit.wall_s})
-    ranking.sort(key=lambda d: -d["score"])
-    best = ranking[0] if ranking else None
     explained_below = max(cfg.explain_factor * floor, floor + cfg.explain_margin)
     for d in ranking:
         d["explains"] = bool(d["shrink_pct"] >= cfg.min_shrink_pct and d["heldout_gap_after"] <= explained_below)
+        if len(d["members"]) > 1:  # each member's share: its own refit's shrink, then what each addition adds
+            shares, done = {}, 0.0
+            for k in range(len(d["members"])):
+                part = " + ".join(d["members"][:k + 1])
+                total = next((r["shrink_pct"] for r in ranking if r["effect"] == part), d["shrink_pct"])
+                shares[d["members"][k]], done = total - done, total
+            d["member_shares_pct"] = shares
+    for d in ranking:
+        d["kept"] = len(d["members"]) == 1 or d["effect"] == selected
+    # the best-scoring model that explains the gap, else the best-scoring one (combinations: only the one kept)
+    ranking.sort(key=lambda d: (not d["kept"], not d["explains"], -d["score"]))
+    best = ranking[0] if ranking else None
     best_cal, best_file = best_calibration_nrmse(gap)
     nominal_fits = best_cal <= cfg.nominal_max_nrmse
     if not nominal_fits:
@@ -121,15 +132,27 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
     elif significant and not chosen and best:
         evidence = [f"best candidate {best['effect']}: held-out NRMSE {best['heldout_gap_after']:.4f}, shrink "
                     f"{best['shrink_pct']:.1f} %; an explanation needs NRMSE <= {explained_below:.4f} (noise "
-                    f"floor {floor:.4f}) and shrink >= {cfg.min_shrink_pct:.0f} %"]
+                    f"floor {floor:.4f}) and shrink >= {cfg.min_shrink_pct:.0f} %",
+                    "held-out shrink by candidate: " + ", ".join(f"{d['effect']} {d['shrink_pct']:.1f} %"
+                                                                 for d in ranking[:5]),
+                    f"the misfit left is largest in the band {gap['worst_band_hz'][0]:.1f}-"
+                    f"{gap['worst_band_hz'][1]:.1f} Hz: an effect outside the candidates acts there (a delay "
+                    "between the channels, the messenger's frequency-dependent loss, backlash), or the "
+                    "description of the system (--nominal) is off there"]
     if chosen:
         sys_effect = system.effects[chosen]
-        rank_screen = sorted(screening, key=lambda k: -screening[k]).index(chosen) + 1
+        ranked_screen = sorted(screening, key=lambda k: -screening[k])
         evidence = [
             f"held-out NRMSE {before:.4f} -> {best['heldout_gap_after']:.4f} (noise floor {floor:.4f}): "
-            f"shrink {best['shrink_pct']:.1f} %",
-            f"screening: its sensitivity explains {100 * screening[chosen]:.1f} % of the nominal residual "
-            f"(rank {rank_screen} of {len(screening)})",
+            f"shrink {best['shrink_pct']:.1f} %"]
+        if len(best["members"]) > 1:
+            evidence.append("share of the shrink: " + ", ".join(
+                f"{m} {v:.1f} %" for m, v in best["member_shares_pct"].items())
+                + " (the first alone, then what each addition adds)")
+        evidence += [
+            f"screening: the sensitivity of {m} explains {100 * screening[m]:.1f} % of the nominal residual "
+            f"(rank {ranked_screen.index(m) + 1} of {len(screening)})" for m in best["members"] if m in screening]
+        evidence += [
             "nominal misfit by level: " + ", ".join(f"{d['level']}: {d['nrmse']:.3f}" for d in levels),
             f"largest misfit in the band {gap['worst_band_hz'][0]:.1f}-{gap['worst_band_hz'][1]:.1f} Hz",
             f"expected signature: {sys_effect.signature}",
@@ -139,7 +162,10 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
             evidence.append("detection lines: odd misfit {:.2e} (noise {:.2e}), even misfit {:.2e} (noise {:.2e})"
                             .format(h["odd_detection"]["misfit"], h["odd_detection"]["noise"],
                                     h["even_detection"]["misfit"], h["even_detection"]["noise"]))
+    shape_starts = {name: [{p.name: p.range(scale)[1] for p in e.params if p.shape}] + list(e.starts(scale))
+                    for name, e in system.effects.items() if name in fits and e.starts(scale) and not e.members}
     return {"verdict": verdict, "chosen_effect": chosen, "significant": significant, "explained_below": explained_below,
+            "shape_starts": shape_starts,
             "runner_up_close": bool(close), "gap": gap, "ranking": ranking, "evidence": evidence,
             "nominal": {"params": _free_values(nominal), "calibration_nrmse": nominal.calibration_nrmse,
                         "evaluations": nominal.evaluations},
@@ -188,7 +214,9 @@ def write(result: dict, records, held, sims, bands, out_dir) -> pathlib.Path:
     f = np.fft.rfftfreq(rec.n, 1.0 / rec.fs)
     sel = (f >= 0.5 * bands[0][0]) & (f <= min(rec.fs / 2, 1.5 * bands[-1][1]))
     curves = [("measured", f[sel], np.abs(np.fft.rfft(rec.outputs[k]))[sel], "k-")]
-    for name in ["nominal"] + ([result["chosen_effect"]] if result["chosen_effect"] else []):
+    # the residual of the nominal model and of the chosen model (else the best-ranked candidate)
+    best = result["chosen_effect"] or (result["ranking"][0]["effect"] if result["ranking"] else None)
+    for name in ["nominal"] + ([best] if best else []):
         if sims[name][rec.name] is not None:
             curves.append((f"residual, {name}", f[sel], np.abs(np.fft.rfft(sims[name][rec.name][k] - rec.outputs[k]))[sel],
                            "-"))
@@ -211,14 +239,19 @@ def markdown(result: dict) -> str:
              f"{g['noise_floor']:.4f} ({', '.join(g.get('noise_floor_method', []))}); nominal calibration NRMSE "
              f"{result['nominal']['calibration_nrmse']:.4f}. An effect explains the gap when the held-out NRMSE with "
              f"it is at most {result['explained_below']:.4f}.", "", "## Which effect", "",
-             "| effect | score | held-out gap after | shrink [%] | screening [%] | added params | fitted |",
+             "| effect | score | held-out gap after | shrink [%] | screening [%] | strength params | fitted |",
              "|---|---|---|---|---|---|---|"]
     for r in result["ranking"]:
         params = ", ".join(f"{k} = {v:.4g}" for k, v in r["params"].items())
         lines.append(f"| {r['effect']} | {r['score']:.1f} | {r['heldout_gap_after']:.4f} | {r['shrink_pct']:.1f} | "
-                     f"{100 * (r['screening_explained'] or 0):.1f} | {r['n_added_params']} | {params} |")
+                     f"{'—' if r['screening_explained'] is None else format(100 * r['screening_explained'], '.1f')} | "
+                     f"{r['n_added_params']} | {params} |")
+    for name, starts in result.get("shape_starts", {}).items():
+        lines += ["", f"{name}: the refit began from the best of these shapes on the calibration files, then fitted "
+                  "the shape: " + "; ".join(", ".join(f"{k} = {v:g}" for k, v in st.items()) for st in starts) + "."]
     if result["ranking"]:
-        lines += ["", "Score = shrink − 5 points per added parameter beyond the first. "
+        lines += ["", "Score = shrink − 5 points per added strength parameter beyond the first (shape parameters "
+                  "are not charged). "
                   "Shrink = (gap before − gap after) / (gap before − reference), reference = the smaller of the "
                   "noise floor and the best held-out gap after (both are upper bounds of the noise)."]
     elif result["verdict"] == "no significant gap":

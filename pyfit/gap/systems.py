@@ -30,24 +30,33 @@ class Scale:
 @dataclass(frozen=True)
 class Param:
     """A fitted parameter: name in the FMU and a function of the Scale giving (lower, start, upper). A `shape`
-    parameter (positive, spanning decades) is fitted on a log scale and held at its start in the screening,
-    which probes the effect's strength only."""
+    parameter is held at its start in the screening, which probes the effect's strength only; a `log` one
+    (positive, spanning decades) is fitted on a log scale."""
 
     name: str
     range: callable
     shape: bool = False
+    log: bool = False
 
 
 @dataclass(frozen=True)
 class Effect:
-    """A candidate unmodelled effect: its free parameters, the fixed values that switch it on, and the
-    signature it leaves (used as evidence in the report)."""
+    """A candidate unmodelled effect: its free parameters, the fixed values that switch it on, the signature
+    it leaves (used as evidence in the report), and other starts of its shape parameters spanning the family
+    (`starts`: Scale -> list of {parameter: value}; the refit begins from the best of them)."""
 
     name: str
     params: tuple[Param, ...]
     fixed: callable = field(default=lambda s: {})
     signature: str = ""
     shift_stiffness: float = 0.0  # the effect's start adds this fraction of the stiffness, taken off the nominal
+    starts: callable = field(default=lambda s: [])
+    members: tuple = ()  # the single effects of a combination (see `combine`); () for a single effect
+
+    @property
+    def strengths(self) -> int:
+        """How many strength (not shape) parameters the effect adds: what the ranking's score charges for."""
+        return sum(not p.shape for p in self.params)
 
     def absent(self, scale: Scale) -> dict:
         """Parameter values at which the effect is not there (the nominal model): strengths at zero where their
@@ -77,6 +86,20 @@ class System:
     deflection_outputs: tuple = ()  # FMU outputs that give the nonlinear element's deflection
     motion_inputs: tuple = ()  # displacement, velocity, acceleration inputs that must be consistent (or ())
     deflection: callable = None  # (simulated outputs, record) -> the element's deflection [m]
+
+
+def combine(effects: list[Effect]) -> Effect:
+    """Several effects at once: their parameters, fixed values and shape starts together (named 'a + b')."""
+    names = [e.name for e in effects]
+    params, seen = [], set()
+    for e in effects:
+        params += [p for p in e.params if p.name not in seen]
+        seen |= {p.name for p in e.params}
+    return Effect(" + ".join(names), tuple(params),
+                  fixed=lambda s: {k: v for e in effects for k, v in e.fixed(s).items()},
+                  signature="; ".join(f"{e.name}: {e.signature}" for e in effects),
+                  shift_stiffness=max(e.shift_stiffness for e in effects),
+                  starts=lambda s: [st for e in effects for st in e.starts(s)], members=tuple(names))
 
 
 def _sym(scale_fn):
@@ -156,17 +179,43 @@ def sdof_stiffness(params: dict) -> float:
 
 # the friction's smoothing velocity v_s [m/s] (F = F_c tanh(v / v_s)): from near-ideal Coulomb (1e-3 of the
 # velocity RMS) to a friction that is still rounding off at half of it; started at 1e-2
-_stick_velocity = Param("v_s", lambda s: (1e-3 * s.sigma_v, 1e-2 * s.sigma_v, 0.5 * s.sigma_v), shape=True)
+_stick_velocity = Param("v_s", lambda s: (1e-3 * s.sigma_v, 1e-2 * s.sigma_v, 0.5 * s.sigma_v), shape=True, log=True)
+
+# Shapes of the Bouc-Wen loop the refit starts from, spanning the family (theory §1.1 and §1.3): with β fixed
+# at 1/sigma_y (SDOF) or D at sigma_y (damper), the loading branch softens when γ + δ > 0 (SDOF) or β + γ > 0
+# (damper) and hardens otherwise; the unloading branch likewise with γ - δ or β - γ; ν from 1 (smooth) to
+# 3 (sharp). The refit begins from the best of them on the calibration records and fits the shape.
+SDOF_LOOP_STARTS = ({"gamma": 0.5, "delta": 0.5, "nu": 1.0},    # softening on both branches, wide loop
+                    {"gamma": 1.5, "delta": -0.5, "nu": 1.0},   # softening loading, sharp unloading
+                    {"gamma": 0.5, "delta": -1.5, "nu": 1.0},   # hardening loading, narrow loop
+                    {"gamma": 1.0, "delta": 0.0, "nu": 2.0},    # symmetric, sharper transition
+                    {"gamma": 0.25, "delta": 0.75, "nu": 3.0})  # nearly elastic-plastic
+DAMPER_LOOP_STARTS = ({"a_bw": 0.5, "beta": 0.75, "gamma": 0.25, "nu": 1.0},
+                      {"a_bw": 0.1, "beta": 0.5, "gamma": 0.5, "nu": 1.0},
+                      {"a_bw": 0.5, "beta": 1.5, "gamma": -0.5, "nu": 1.0},
+                      {"a_bw": 0.2, "beta": 0.25, "gamma": 0.75, "nu": 2.0},
+                      {"a_bw": 0.7, "beta": 1.0, "gamma": 0.0, "nu": 3.0})
+
+HYSTERETIC_FRACTIONS = (0.1, 0.3, 0.6)  # share of the stiffness the hysteretic element holds at small amplitude
+
+
+def _sdof_loop_starts(s: Scale) -> list[dict]:
+    """Every loop shape at every hysteretic share of the calibrated stiffness (k + alpha = the nominal k), but
+    the default start (the first shape at the first share)."""
+    return [{"k": (1.0 - f) * s.k, "alpha": f * s.k, **shape} for f in HYSTERETIC_FRACTIONS
+            for shape in SDOF_LOOP_STARTS][1:]
+
 
 SDOF_EFFECTS = {
     "hysteresis": Effect(
         "hysteresis",
         (Param("alpha", lambda s: (0.0, 0.1 * s.k, 2.0 * s.k)),
-         Param("gamma", lambda s: (-5.0, 0.8, 5.0)),
-         Param("delta", lambda s: (-5.0, -1.1, 5.0))),
-        fixed=lambda s: {"beta": 1.0 / s.sigma_y, "nu": 1.0},
-        signature="amplitude-dependent stiffness and damping (softening loops), odd distortion",
-        shift_stiffness=0.1),
+         Param("gamma", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["gamma"], 5.0)),
+         Param("delta", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["delta"], 5.0)),
+         Param("nu", shape=True, range=lambda s: (1.0, SDOF_LOOP_STARTS[0]["nu"], 3.0))),
+        fixed=lambda s: {"beta": 1.0 / s.sigma_y},
+        signature="amplitude-dependent stiffness and damping (hysteresis loops), odd distortion",
+        shift_stiffness=0.1, starts=lambda s: _sdof_loop_starts(s)),
     "cubic_stiffness": Effect(
         "cubic_stiffness", (Param("k3", _sym(lambda s: 0.3 * s.k / s.sigma_y**2)),),
         signature="resonance shift with amplitude squared, odd distortion"),
@@ -242,11 +291,15 @@ def _pair(name1, name2, rng):
 
 
 DAMPER_EFFECTS = {
-    "hysteresis": Effect(
+    "hysteresis": Effect(  # A = 1 and D = sigma_y: only β D^-ν, γ D^-ν (with ν) are identifiable (theory §1.3)
         "hysteresis", _pair("k_bw1", "k_bw2", lambda s: (0.0, 0.05 * s.k, 0.5 * s.k))
-        + (Param("D", lambda s: (0.1 * s.sigma_y, s.sigma_y, 10 * s.sigma_y)),),
-        fixed=lambda s: {"a_bw": 0.3, "A": 1.0, "beta": 0.6, "gamma": 0.4, "nu": 1.0},
-        signature="amplitude-dependent stiffness and damping of the cable (softening loops), odd distortion"),
+        + (Param("a_bw", shape=True, range=lambda s: (0.0, DAMPER_LOOP_STARTS[0]["a_bw"], 1.0)),
+           Param("beta", shape=True, range=lambda s: (0.0, DAMPER_LOOP_STARTS[0]["beta"], 5.0)),
+           Param("gamma", shape=True, range=lambda s: (-5.0, DAMPER_LOOP_STARTS[0]["gamma"], 5.0)),
+           Param("nu", shape=True, range=lambda s: (1.0, DAMPER_LOOP_STARTS[0]["nu"], 3.0))),
+        fixed=lambda s: {"A": 1.0, "D": s.sigma_y},
+        signature="amplitude-dependent stiffness and damping of the cable (hysteresis loops), odd distortion",
+        starts=lambda s: [dict(st) for st in DAMPER_LOOP_STARTS[1:]]),
     "cubic_stiffness": Effect(
         "cubic_stiffness", _pair("k_cs1", "k_cs2", _sym(lambda s: 0.3 * s.k / s.sigma_y**2)),
         signature="resonance shifts with amplitude squared, odd distortion"),
