@@ -24,7 +24,9 @@ def _sdof_hysteresis_truths(n: int) -> list[dict]:
         if gamma + delta <= 0.1 and gamma - delta <= 0.1:
             continue  # z would grow without bound on both branches
         k = 1e5 * RNG.uniform(0.4, 0.7)
-        out.append({"k": k, "alpha": 1e5 - k, "beta": 10.0 ** RNG.uniform(1.7, 2.5) / 100.0 ** (nu - 1.0),
+        # the hysteretic force turns over near z_y (50-500 N at these levels): β |z_y|^ν ≈ α
+        z_y = 10.0 ** RNG.uniform(1.7, 2.7)
+        out.append({"k": k, "alpha": 1e5 - k, "beta": (1e5 - k) / z_y ** nu,
                     "gamma": float(gamma), "delta": float(delta), "nu": float(nu)})
     return out
 

@@ -185,3 +185,15 @@ def upsample_spline(u: np.ndarray, factor: int) -> np.ndarray:
     t = np.arange(len(u))
     tf = np.arange((len(u) - 1) * factor + 1) / factor
     return scipy.interpolate.CubicSpline(t, u, bc_type="natural")(tf)
+
+
+def delayed(y: np.ndarray, fs: float, delay_s: float, periodic: bool = False) -> np.ndarray:
+    """y(t - delay_s) on y's own grid [s]: a periodic record by a phase shift of its DFT (exact for whole
+    periods), otherwise by its cubic spline, held at the first or last sample beyond the record."""
+    if delay_s == 0.0:
+        return y
+    if periodic:
+        f = np.fft.rfftfreq(len(y), 1.0 / fs)
+        return np.fft.irfft(np.fft.rfft(y) * np.exp(-2j * np.pi * f * delay_s), len(y))
+    t = np.arange(len(y)) / fs
+    return scipy.interpolate.CubicSpline(t, y)(np.clip(t - delay_s, 0.0, t[-1]))

@@ -45,7 +45,7 @@ SDOF = Family(
     "SDOFBoucWen", {"m": 2.0, "c": 10.0, "k": 1e5, "alpha": 0.0},  # f0 = 35.6 Hz, zeta = 1.1 %
     {"hysteresis": {"k": 5e4, "alpha": 5e4, "beta": 100.0, "gamma": 0.8, "delta": -1.1},
      "cubic_stiffness": {"k3": 3e8}, "coulomb_friction": {"F_c": 1.0, "v_s": 1e-3},
-     "quadratic_damping": {"c2": 10.0}, "none": {}},
+     "quadratic_damping": {"c2": 10.0}, "sensor_delay": {"sensor_delay": 1.3e-3}, "none": {}},
     {"beta": 0.0, "k3": 0.0, "F_c": 0.0, "c2": 0.0},
     (10.0, 25.0, 50.0), "N", (5.0, 80.0), 500.0, 2048, 1, ("y",), 5e-6)
 
@@ -57,6 +57,7 @@ DAMPER = Family(
      "cubic_stiffness": {"k_cs1": 8e8, "k_cs2": 2.4e9},  # hardening: the thesis's softening diverges here
      "coulomb_friction": {"F_c1": 0.08, "F_c2": 0.12, "v_s": 1e-3},
      "quadratic_damping": {"c2_1": 12.0, "c2_2": 20.0},
+     "sensor_delay": {"sensor_delay": 0.9e-3},  # the clamp channels 0.9 ms ahead of the responses
      "mass_eccentricity": {"a1": lambda p: p["a1"] + 0.015, "a2": lambda p: p["a2"] + 0.015},  # 15 mm further out
      "none": {}},
     dict(_DAMPER_OFF),
@@ -134,21 +135,24 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
         else:
             signal = PeriodicSignal(multisine(spp, fs, *family.band_hz, level, seed, odd=True), fs)
             stop, keep = (lead + periods + 1) * spp / fs, slice(lead * spp, (lead + periods) * spp)
-        t, exact, _ = simulate_truth(SyntheticSpec(family.model, signal, stop, fs, list(recorded), truth,
+        physical = {k: v for k, v in truth.items() if k != "sensor_delay"}  # the delay is in the recording
+        t, exact, _ = simulate_truth(SyntheticSpec(family.model, signal, stop, fs, list(recorded), physical,
                                                    oversample=10))
         clean = simulate_truth(SyntheticSpec(family.model, signal, stop, fs, list(recorded),
-                                             {**truth, **family.tangent}, oversample=10))[1]
+                                             {**physical, **family.tangent}, oversample=10))[1]
         tk = t[keep] - t[keep][0]
         num = sum(np.mean((exact[o][keep] - clean[o][keep]) ** 2) for o in recorded)
         den = sum(np.mean(clean[o][keep] ** 2) for o in recorded)
         rms = sum(np.mean(exact[o][keep] ** 2) for o in recorded)
         key = f"{level:g}"
         changes[key] = {"rms": float(np.sqrt(rms / den) - 1.0), "output": float(np.sqrt(num / den))}
+        # a skew between the channels: the input channel records the signal `sensor_delay` seconds early
+        t_in = t[keep] + truth.get("sensor_delay", 0.0)
         if family.model == "SDOFBoucWen":
-            inputs = {"u_meas": (signal(t[keep]), "N", "u")}
+            inputs = {"u_meas": (signal(t_in), "N", "u")}
         else:
-            motion = (motion_with_derivatives(signal, t[keep], ("x", "v", "a")) if sweep else
-                      {"x": signal(t[keep]), "v": signal.derivative(t[keep], 1), "a": signal.derivative(t[keep], 2)})
+            motion = (motion_with_derivatives(signal, t_in, ("x", "v", "a")) if sweep else
+                      {"x": signal(t_in), "v": signal.derivative(t_in, 1), "a": signal.derivative(t_in, 2)})
             inputs = {f"{var}_meas": (motion[k], u, var) for k, u, var in
                       (("x", "m", "x_base"), ("v", "m/s", "v_base"), ("a", "m/s2", "a_base")) if k in style.motion}
         outputs = {f"{o}_meas": (exact[o][keep] + rng.normal(0.0, _noise_of(family, o, clean[o][keep]), len(tk)),
@@ -206,7 +210,8 @@ def write_cases(out_dir, family: str = "sdof", null_seeds=(0, 1, 2), periods: in
     if style.excitation == "impedance":
         if family != "damper":
             raise ValueError(f"excitation 'impedance' is a damper test; the family is '{family}'")
-        return ([write_impedance_case(out / f"damper_{e}", e, base=base) for e in fam.withheld if e != "none"]
+        return ([write_impedance_case(out / f"damper_{e}", e, base=base) for e in fam.withheld
+                 if e not in ("none", "sensor_delay")]  # an impedance table has no channels to skew
                 + [write_impedance_case(out / f"damper_none_seed{s}", "none", s, base) for s in null_seeds])
     paths = [write_dataset(out / f"{family}_{e}", fam, e, periods=periods, style=style, base=base)
              for e in fam.withheld if e != "none"]

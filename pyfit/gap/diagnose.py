@@ -47,9 +47,9 @@ class DiagnoseConfig:
     explain_factor: float = 3.0  # ... and bring the held-out NRMSE within explain_factor x the noise floor
     explain_margin: float = 0.02  # ... or within the floor + explain_margin (the absolute criterion)
     nominal_max_nrmse: float = 0.8  # a nominal whose NRMSE on its best calibration file exceeds this "does not fit"
-    max_effects: int = 2  # effects combined at most when no single one explains the gap (forward selection)
+    max_effects: int = 2  # effects combined at most (forward selection, while the misfit is above the noise)
     partners: int = 3  # candidates tried as the next member of a combination (the best single refits)
-    min_gain: float = 5.0  # score points a larger combination must gain to be kept
+    min_excess_cut: float = 0.5  # share of the misfit above the noise floor a larger combination must remove
 
 
 _SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
@@ -147,22 +147,27 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
 
 def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, scale, fits: dict, sims: dict, gap,
                   runner, out: pathlib.Path, key: str, workers, progress):
-    """Forward selection when no single effect explains the held-out gap: add to the best model so far each of
-    the `cfg.partners` best-scoring other effects, refit jointly (from each member's own refit and the effects'
-    starts), and keep the best combination while it gains `cfg.min_gain` score points, up to `cfg.max_effects`
-    members or until it explains the gap. Adds the combinations' fits and held-out simulations to `fits` and
-    `sims`; returns the system with the combined effects among its effects, and the model selected (a single
-    effect or a combination; None when nothing was tried)."""
+    """Forward selection while the best model's held-out misfit stays above the noise (`noise_factor` x the
+    floor): extend it by each of the `cfg.partners` best-scoring other effects, refit jointly (from each
+    member's own refit and the effects' starts), and keep the best combination when it removes `min_excess_cut`
+    of the misfit above the floor that the model it extends leaves once refitted with the same budget, up to
+    `cfg.max_effects` members. Adds the fits and held-out simulations to `fits` and `sims`; returns the system
+    with the combined effects among its effects and the model selected (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
-    explained_below = max(cfg.explain_factor * floor, floor + cfg.explain_margin)
-    scores = {n: selection.score(before, selection.heldout_nrmse(sims[n], held), floor, f.n_added)
-              for n, f in fits.items()}
-    ranked = sorted(scores, key=lambda n: -scores[n])
-    if not ranked or selection.heldout_nrmse(sims[ranked[0]], held) <= explained_below:
+    at_noise = cfg.noise_factor * floor
+    after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
+    ranked = sorted(fits, key=lambda n: -selection.score(before, after[n], floor, fits[n].n_added))
+    if not ranked or after[ranked[0]] <= at_noise:
         return system, None
     effects = dict(system.effects)
     current = ranked[0]
-    while len(effects[current].members or (current,)) < cfg.max_effects:
+
+    def simulated(name):
+        sims[name] = {r.name: sim.simulate(runner, r, fits[name].params, cfg.upsample, system.lead_periods)
+                      for r in held}
+        after[name] = selection.heldout_nrmse(sims[name], held)
+
+    while len(effects[current].members or (current,)) < cfg.max_effects and after[current] > at_noise:
         members = list(effects[current].members or (current,))
         # the model so far, refitted on from its own result with a combination's budget: a combination must
         # beat more evaluations of its first member(s), not only the first refit
@@ -189,22 +194,14 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 fits[fit.effect] = fit
         if again.calibration_nrmse < fits[current].calibration_nrmse:
             fits[current] = again
-            sims[current] = {r.name: sim.simulate(runner, r, again.params, cfg.upsample, system.lead_periods)
-                             for r in held}
-            scores[current] = selection.score(before, selection.heldout_nrmse(sims[current], held), floor,
-                                              again.n_added)
+            simulated(current)
         for name in names:
-            sims[name] = {r.name: sim.simulate(runner, r, fits[name].params, cfg.upsample, system.lead_periods)
-                          for r in held}
-            scores[name] = selection.score(before, selection.heldout_nrmse(sims[name], held), floor,
-                                           fits[name].n_added)
-        best = max(names, key=lambda n: scores[n], default=None)
-        if (best is None or scores[best] < scores[current] + cfg.min_gain
-                or selection.heldout_nrmse(sims[current], held) <= explained_below):
+            simulated(name)
+        best = min(names, key=lambda n: after[n], default=None)
+        excess = after[current] - floor
+        if best is None or after[best] - floor > (1.0 - cfg.min_excess_cut) * excess:
             break
         current = best
-        if selection.heldout_nrmse(sims[current], held) <= explained_below:
-            break
     return dataclasses.replace(system, effects=effects), current
 
 
@@ -247,7 +244,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)
     judging = ("min_gap", "noise_factor", "close_points", "min_shrink_pct", "explain_factor", "explain_margin",
-               "nominal_max_nrmse", "max_effects", "partners", "min_gain")  # how results are judged and which
+               "nominal_max_nrmse", "max_effects", "partners", "min_excess_cut")  # how results are judged and which
     # combinations are tried, not how a fit is made: stored fits stay valid
     settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in judging}, sort_keys=True)
     description = json.dumps({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}

@@ -195,7 +195,8 @@ def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu
     if significant and nominal_fits:
         scale = deflection_scale(fmu, cal, {**defaults, **nominal_fit.params})
         free, jobs = {}, []
-        for name in cfg.effects or list(system.effects):
+        # an impedance table carries no time signals: effects on the recorded channels do not apply
+        for name in cfg.effects or [n for n, e in system.effects.items() if not e.signal_only]:
             effect, path = system.effects[name], out / "fits" / f"{name}.json"
             e_start, e_bounds, e_fixed = effect_start(system, effect, scale, nominal_fit.params)
             free[name], stored = list(e_start), _stored(path, key)

@@ -108,8 +108,9 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
             d["member_shares_pct"] = shares
     for d in ranking:
         d["kept"] = len(d["members"]) == 1 or d["effect"] == selected
-    # the best-scoring model that explains the gap, else the best-scoring one (combinations: only the one kept)
-    ranking.sort(key=lambda d: (not d["kept"], not d["explains"], -d["score"]))
+    # the model the selection kept if it explains the gap, else the best-scoring one that does, else the
+    # best-scoring one (combinations: only the one kept)
+    ranking.sort(key=lambda d: (not d["kept"], not d["explains"], d["effect"] != selected, -d["score"]))
     best = ranking[0] if ranking else None
     best_cal, best_file = best_calibration_nrmse(gap)
     nominal_fits = best_cal <= cfg.nominal_max_nrmse

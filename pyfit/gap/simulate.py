@@ -8,10 +8,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pyfit.analysis import kinematics
-from pyfit.analysis.signals import without_offset
+from pyfit.analysis.signals import delayed, without_offset
 from pyfit.io.data import Measurement
 from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.drive import drive
+
+
+SENSOR_DELAY = "sensor_delay"  # candidate parameter [s]: the outputs lag the inputs by it (channel skew)
 
 
 @dataclass
@@ -102,9 +105,13 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
     """Outputs (model variable -> the compared samples of the record's grid, less their mean; default: the
     record's outputs) for FMU parameters params; None on failure. A periodic record is preceded by
     lead_periods simulated periods."""
+    params = dict(params)
+    delay = params.pop(SENSOR_DELAY, 0.0)  # not an FMU parameter: a lag of the output channels behind the inputs
     res = drive(runner, rec.inputs, rec.fs, list(outputs or rec.outputs), params, upsample, rec.samples_per_period,
                 lead_periods if rec.periodic else 0, tolerance)
-    return {k: without_offset(v[rec.first:]) for k, v in res.values.items()} if res.ok else None
+    if not res.ok:
+        return None
+    return {k: without_offset(delayed(v, rec.fs, delay, rec.periodic)[rec.first:]) for k, v in res.values.items()}
 
 
 def residuals(sim: dict | None, rec: Record, penalty: float = 10.0, of=None) -> np.ndarray:

@@ -52,6 +52,7 @@ class Effect:
     shift_stiffness: float = 0.0  # the effect's start adds this fraction of the stiffness, taken off the nominal
     starts: callable = field(default=lambda s: [])
     members: tuple = ()  # the single effects of a combination (see `combine`); () for a single effect
+    signal_only: bool = False  # acts on the recorded channels, not in the FMU (pyfit.gap.simulate applies it)
 
     @property
     def strengths(self) -> int:
@@ -206,6 +207,12 @@ def _sdof_loop_starts(s: Scale) -> list[dict]:
             for shape in SDOF_LOOP_STARTS][1:]
 
 
+# a lag of the output channels behind the inputs (unsynchronised DAQ modules, different anti-alias filters):
+# up to half a radian at the data's dominant frequency (sigma_y / sigma_v ~ 1/ω), either sign
+SENSOR_DELAY = Effect(
+    "sensor_delay", (Param("sensor_delay", _sym(lambda s: 0.5 * s.sigma_y / s.sigma_v)),),
+    signature="a phase error that grows in proportion to frequency, the same at every level", signal_only=True)
+
 SDOF_EFFECTS = {
     "hysteresis": Effect(
         "hysteresis",
@@ -225,6 +232,7 @@ SDOF_EFFECTS = {
     "quadratic_damping": Effect(
         "quadratic_damping", (Param("c2", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y / s.sigma_v**2)),),
         signature="damping that grows with amplitude (largest misfit at the highest level)"),
+    "sensor_delay": SENSOR_DELAY,
 }
 
 # ---- Stockbridge damper ------------------------------------------------------------------------------------
@@ -313,6 +321,7 @@ DAMPER_EFFECTS = {
         "mass_eccentricity", (Param("a1", lambda s: (s.nominal["a1"] - 0.03, s.nominal["a1"], s.nominal["a1"] + 0.03)),
                               Param("a2", lambda s: (s.nominal["a2"] - 0.03, s.nominal["a2"], s.nominal["a2"] + 0.03))),
         signature="amplitude-independent shift of the modes (the same misfit at every level)"),
+    "sensor_delay": SENSOR_DELAY,
 }
 
 @dataclass(frozen=True)
