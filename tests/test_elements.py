@@ -10,7 +10,7 @@ from fmpy.validation import validate_fmu
 
 from pyfit.build import EXAMPLES
 from pyfit.analysis.excitation import Excitation, motion_with_derivatives
-from pyfit.runtime.element_docs import REFERENCE_RUNS, write_docs
+from pyfit.runtime.element_docs import REFERENCE_RUNS
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 

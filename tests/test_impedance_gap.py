@@ -44,6 +44,7 @@ def test_sidecar_states_the_uncertainty_the_noise_stays_below(tmp_path):
     assert 0.004 < noise < IMPEDANCE_UNCERTAINTY  # 0.5 % in |Z| and 0.3° in phase: about 0.0073
 
 
+@pytest.mark.slow
 def test_null_case_is_no_significant_gap(fmu_dir, tmp_path, measured, monkeypatch):
     case = write_impedance_case(tmp_path / "damper_none", "none", seed=2)
     run = _diagnose_cli(case / "impedance_test.csv", tmp_path / "out", fmu_dir, "--workers", "1")

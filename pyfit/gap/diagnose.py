@@ -148,7 +148,8 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
 def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, scale, fits: dict, sims: dict, gap,
                   runner, out: pathlib.Path, key: str, workers, progress):
     """Forward selection while the best model's held-out misfit stays above the noise (`noise_factor` x the
-    floor): extend it by each of the `cfg.partners` best-scoring other effects, refit jointly (from each
+    floor): extend it by each of the `cfg.partners` other effects whose sensitivity at that model explains most
+    of its calibration residual (the screening repeated there), refit jointly (from each
     member's own refit and the effects' starts), and keep the best combination when it removes `min_excess_cut`
     of the misfit above the floor that the model it extends leaves once refitted with the same budget, up to
     `cfg.max_effects` members. Adds the fits and held-out simulations to `fits` and `sims`; returns the system
@@ -176,7 +177,11 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         jobs = [] if again else [(effect_task(system, effects[current], fmu, cal, nominal, scale, cfg.refit_budget,
                                               cfg.upsample, seeds=(fits[current].params,)), str(again_path), key)]
         names = []
-        for partner in [n for n in ranked if n not in members and n in system.effects][:cfg.partners]:
+        # the next member: the candidates whose sensitivity at the model so far explains most of its residual
+        # on the calibration files (the screening's score test, repeated at that model)
+        others = [n for n in system.effects if n not in members and n in fits]
+        explained, _ = screen(system, fmu, cal, fits[current], scale, cfg.upsample, others)
+        for partner in sorted(others, key=lambda n: -explained[n])[:cfg.partners]:
             combo = combine([system.effects[m] for m in members + [partner]])
             effects[combo.name] = combo
             path = out / "fits" / f"{combo.name.replace(' + ', '+')}.json"
