@@ -34,6 +34,7 @@ def _rerun_from_stored_fits(monkeypatch, *args, **kwargs) -> dict:
     return diagnose_impedance(*args, **kwargs)
 
 
+@pytest.mark.slow
 def test_sidecar_states_the_uncertainty_the_noise_stays_below(tmp_path):
     case = write_impedance_case(tmp_path / "none", "none")
     test = read_impedance(case / "impedance_test.csv")
