@@ -242,6 +242,7 @@ def _resonance_log_psd_residuals(x):
     return log_psd(np.asarray(x)) - log_psd(np.array([0.52, 0.3]))
 
 
+@pytest.mark.slow  # 90 s of FMU runs; the NNO loop on a known residual: test_nno_finds_the_optimum_returns_the_best_point
 def test_trust_region_nno_pins_frequency_and_damping_of_a_resonance(measured):
     """Where a global surrogate cannot resolve a sharp resonance from 10-40 samples (it left zeta off by
     0.07-0.16 in unit terms on seeds 0-2 when this test was written), the trust-region box keeps the GA where
