@@ -1,4 +1,4 @@
-"""The span a design check is for (`python scripts/design_check.py SPAN.toml`). SI units; a TOML file:
+"""The span a design check is for (`stockbridge design-check SPAN.toml`). SI units; a TOML file:
 
     [conductor]
     type = "drake"                 # from pyfit.design.conductor.CONDUCTORS, or every field below:

@@ -268,7 +268,7 @@ def run(fmu_dir: pathlib.Path, out_dir: pathlib.Path, names: list[str], n_sample
     for name in names:
         fmu = pathlib.Path(fmu_dir) / f"{name}.fmu"
         if not fmu.exists():
-            raise FileNotFoundError(f"{fmu}: FMU not found (build it with: python scripts/build_fmus.py {name})")
+            raise FileNotFoundError(f"{fmu}: FMU not found (build it with: stockbridge build {name})")
         results += check_rhs_and_jacobian(name, fmu, n_samples)
         results += check_trajectories(name, fmu, out_dir)
     (out_dir / "crosscheck.json").write_text(json.dumps([asdict(r) for r in results], indent=1))

@@ -87,13 +87,13 @@ def write_docs(name: str, fmu: str | pathlib.Path, out_dir: str | pathlib.Path) 
     runner.close()
     lines = [f"# {name}", "", md.description or "", "",
              f"FMI {md.fmiVersion} Model Exchange and Co-Simulation, generated from "
-             f"`modelica/` by `python scripts/build_fmus.py` (pyfit); GUID `{md.guid}`.",
+             f"`modelica/` by `stockbridge build` (pyfit); GUID `{md.guid}`.",
              "Co-simulation: adaptive DOPRI5 inside each communication step (tolerance from fmi2SetupExperiment), "
              "inputs linear over a step when their derivatives are set (canInterpolateInputs). The same model "
              f"as FMI 3.0: `fmus/fmi3/{name}.fmu`.", ""]
     lines += ["## Variables (SI units)", ""] + _table(md, "input") + _table(md, "output") + _table(md, "parameter")
     lines += ["## Reference result", "", f"[`{csv.name}`]({csv.name}): {what}; output interval {STEP} s, "
               f"{STOP} s, tolerance 1e-10, inputs linear between samples. Regenerate with "
-              "`python scripts/element_docs.py`.", ""] + ([held_note, ""] if held_note else [])
+              "`stockbridge element-docs`.", ""] + ([held_note, ""] if held_note else [])
     (folder / "README.md").write_text("\n".join(lines))
     return folder
