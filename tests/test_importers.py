@@ -23,10 +23,17 @@ CASES = {
 }
 
 
+def libcosim_loadable() -> str:
+    """Why libcosimpy cannot be loaded here ('' if it can)."""
+    if importlib.util.find_spec("libcosimpy") is None:
+        return 'libcosimpy is not installed (pip install -e ".[importers]")'
+    return ""
+
+
 def ecos_loadable() -> str:
     """Why ecospy cannot be loaded here ('' if it can)."""
     if importlib.util.find_spec("ecospy") is None:
-        return "ecospy is not installed (pip install ecospy)"
+        return 'ecospy is not installed (pip install -e ".[importers]")'
     try:
         import ecospy  # noqa: F401
     except OSError as exc:
@@ -78,7 +85,7 @@ def ecos_run(fmu, outputs, ints, reals, stop):
     return np.array(rows)
 
 
-IMPORTERS = {"libcosim": (libcosim_run, lambda: ""), "Ecos": (ecos_run, ecos_loadable)}
+IMPORTERS = {"libcosim": (libcosim_run, libcosim_loadable), "Ecos": (ecos_run, ecos_loadable)}
 
 
 @pytest.mark.parametrize("importer", list(IMPORTERS))
