@@ -48,7 +48,7 @@ class DiagnoseConfig:
     explain_margin: float = 0.02  # ... or within the floor + explain_margin (the absolute criterion)
     nominal_max_nrmse: float = 0.8  # a nominal whose NRMSE on its best calibration file exceeds this "does not fit"
     max_effects: int = 2  # effects combined at most (forward selection, while the misfit is above the noise)
-    partners: int = 3  # candidates tried as the next member of a combination (the best single refits)
+    partners: int = 3  # candidates tried as the next member of a combination (by the screening at that model)
     min_excess_cut: float = 0.5  # share of the misfit above the noise floor a larger combination must remove
 
 
@@ -157,11 +157,10 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     before, floor = gap["overall"], gap["noise_floor"]
     at_noise = cfg.noise_factor * floor
     after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
-    ranked = sorted(fits, key=lambda n: -selection.score(before, after[n], floor, fits[n].n_added))
-    if not ranked or after[ranked[0]] <= at_noise:
+    current = max(fits, key=lambda n: selection.score(before, after[n], floor, fits[n].n_added), default=None)
+    if current is None or after[current] <= at_noise:
         return system, None
     effects = dict(system.effects)
-    current = ranked[0]
 
     def simulated(name):
         sims[name] = {r.name: sim.simulate(runner, r, fits[name].params, cfg.upsample, system.lead_periods)
