@@ -38,12 +38,7 @@ def _starts_hold_none_of(truth: dict, effect) -> bool:
     return all(any(abs(s.get(k, np.inf) - v) > 1e-9 for k, v in truth.items() if k in s) for s in starts)
 
 
-NU_ABOVE_ONE = pytest.mark.xfail(strict=True, reason=(
-    "β is held at 1/σ_y, the scale of a ν = 1 loop; for ν > 1 the refit cannot reach the loop's yield (measured: "
-    "80 % shrink at ν = 2, 64 % at ν = 3): β needs the scale of z^(ν-1) too, or to be fitted on a log scale"))
-
-
-@pytest.mark.parametrize("case", [0, pytest.param(1, marks=NU_ABOVE_ONE), pytest.param(2, marks=NU_ABOVE_ONE)])
+@pytest.mark.parametrize("case", [0, 1, 2])
 def test_sdof_hysteresis_of_a_random_shape_is_named(tmp_path, fmu_dir, case, measured):
     truth = _sdof_hysteresis_truths(3)[case]
     assert _starts_hold_none_of(truth, SDOF_EFFECTS["hysteresis"])

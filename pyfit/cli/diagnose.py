@@ -13,6 +13,8 @@ EXAMPLE = """examples:
   stockbridge diagnose --make-datasets cases/ --excitation sweep --record a # withheld-effect test cases
   stockbridge diagnose --cases cases/ --out results/cases                   # every dataset under cases/
   stockbridge diagnose --benchmark --config configs/diagnose_benchmark.toml # official Bouc-Wen signals
+  stockbridge diagnose --campaign 200 --out results/campaign                # random truths, a Dask LocalCluster
+  stockbridge diagnose --campaign 200 --scheduler tcp://10.0.0.5:8786       # ... on a Dask cluster
 
 A dataset is a folder of measurement files (CSV + TOML sidecar, one per level; docs: measurement files).
 Writes report.md (verdict, ranked effects, shrink on held-out files), report.json and figures into --out."""
@@ -42,13 +44,19 @@ def add_arguments(ap) -> None:
                          "damper) an impedance test")
     ap.add_argument("--record", nargs="+", metavar="OUTPUT", help="with --make-datasets: the outputs recorded "
                     "(default: displacements; e.g. a, or acc_x1 acc_x2)")
+    ap.add_argument("--campaign", type=int, metavar="N", help="validation campaign: draw N random SDOF cases "
+                    "(effects, pairs, nulls; strengths, loop shapes, excitation, sensor), write and diagnose each, "
+                    "summarise (confusion matrix, detection limit, false alarms) in OUT/summary.md; resumes")
+    ap.add_argument("--campaign-seed", type=int, default=0, help="with --campaign: the draw's seed")
+    ap.add_argument("--scheduler", help="with --campaign: a Dask scheduler address (default: a LocalCluster of "
+                                        "--workers processes, 2 if not given)")
     ap.add_argument("--motion", default="xva", help="with --make-datasets --model damper: which of the clamp's "
                                                     "x, v, a are recorded (e.g. x)")
 
 
 def run(args, ap) -> int:
     """Dispatch to the dataset writer, the case runner, the impedance or the measurement diagnosis."""
-    from pyfit.gap import cases, datasets
+    from pyfit.gap import campaign, cases, datasets
     from pyfit.gap.diagnose import diagnose, load_config
     from pyfit.gap.impedance_gap import diagnose_impedance
     from pyfit.io import benchmark_data
@@ -61,6 +69,10 @@ def run(args, ap) -> int:
             base = load_nominal(args.nominal).fixed if args.nominal else None  # uncertain ones: FMU defaults
             for path in datasets.write_cases(args.make_datasets, args.model, args.seeds, style=style, base=base):
                 print(path)
+            return 0
+        if args.campaign:
+            campaign.run(args.campaign, args.out, args.fmus, args.campaign_seed, args.workers or 2, args.scheduler)
+            print((pathlib.Path(args.out) / "summary.md").read_text())
             return 0
         cfg = load_config(args.config) if args.config else None
         if args.cases:

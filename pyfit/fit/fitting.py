@@ -61,22 +61,31 @@ def _objective(cfg: FitConfig, fmu, measurement, kind: str) -> Objective | Imped
                      cfg.warmup_s, cfg.tolerance, cfg.penalty, cfg.use_inputs, cfg.input_upsample, cfg.input_periodic)
 
 
-def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: int,
-            stop_at: float | None = None) -> dict:
-    """Fit with cfg's method and the given seed; write result.json and figures into out_dir; return the result.
-    stop_at: the GA baseline stops when its error first reaches this value (the NNO-vs-GA comparison)."""
-    out_dir.mkdir(parents=True, exist_ok=True)
-    clock = StageClock()
-    fmu = ensure_fmu(cfg.model, fmu_dir)
-    impedance = cfg.objective_kind == "impedance"
-    measurement = read_impedance(cfg.target_file) if impedance else read_measurement(cfg.target_file)
-    obj = _objective(cfg, fmu, measurement, cfg.objective_kind)
+@dataclasses.dataclass
+class Search:
+    """The optimiser's outcome: the best point (unit-scaled), the global stage's result, the history of every
+    true evaluation (stage-tagged, evaluations counted over all stages), and the objective of the last stage."""
+
+    x: np.ndarray
+    global_result: object  # OptimResult of the global stage
+    history: list
+    ann: list
+    true_evaluations: int
+    stop_reason: str
+    final_objective: object
+
+
+def search(cfg: FitConfig, objective_of, seed: int, stop_at: float | None = None, clock: StageClock | None = None
+           ) -> Search:
+    """cfg's method with the given seed: the global stage on objective_of(cfg.objective_kind), then (nno+polish)
+    each polish stage on objective_of(kind), from the best point so far. objective_of: kind -> an objective with
+    residuals(x) on unit-scaled x (and log_ratio for NNO's transform)."""
+    obj = objective_of(cfg.objective_kind)
     n = len(cfg.variables)
-    history, ann = [], []
-    settings = dataclasses.replace(cfg.nno, seed=seed)
-    clock.end("setup (FMU, measurement, objective)")
+    ann = []
     if cfg.method in ("nno", "nno+polish"):
-        res = nno(obj.residuals, n, settings, transform=obj.log_ratio if cfg.nno_log_ratio else None)
+        res = nno(obj.residuals, n, dataclasses.replace(cfg.nno, seed=seed),
+                  transform=obj.log_ratio if cfg.nno_log_ratio else None)
         ann = [h for h in res.history if h.get("ann_error") is not None]
     elif cfg.method == "ga":
         res, _ = baselines.ga_direct(obj.residuals, n, cfg.budget, cfg.ga_pop_size, seed, stop_at)
@@ -85,19 +94,49 @@ def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: 
     else:
         res = baselines.polish(obj.residuals, np.full(n, 0.5), cfg.budget)
     history = [dict(h, stage="global") for h in res.history]
-    clock.end(f"global search ({cfg.method.split('+')[0]})")
-    best_x, n_eval, stop = res.x, res.n_evaluations, res.stop_reason
-    objectives = {cfg.objective_kind: obj}
-    final_obj = obj
+    if clock:
+        clock.end(f"global search ({cfg.method.split('+')[0]})")
+    best_x, n_eval, stop, final_obj = res.x, res.n_evaluations, res.stop_reason, obj
     if cfg.method == "nno+polish":
         for kind, budget in zip(cfg.polish_kinds, cfg.polish_budgets):
-            if kind not in objectives:
-                objectives[kind] = _objective(cfg, fmu, measurement, kind)
-            final_obj = objectives[kind]
+            final_obj = objective_of(kind)
             pol = baselines.polish(final_obj.residuals, best_x, budget)
             history += [dict(h, stage=f"polish:{kind}", evaluations=h["evaluations"] + n_eval) for h in pol.history]
             best_x, n_eval, stop = pol.x, n_eval + pol.n_evaluations, f"{stop}+{kind}:{pol.stop_reason}"
-            clock.end(f"polish ({kind})")
+            if clock:
+                clock.end(f"polish ({kind})")
+    return Search(best_x, res, history, ann, int(n_eval), stop, final_obj)
+
+
+def open_objectives(cfg: FitConfig, fmu_dir: pathlib.Path):
+    """A cache of cfg's objectives on its target (kind -> Objective, opened on first use), and the measurement."""
+    fmu = ensure_fmu(cfg.model, fmu_dir)
+    impedance = cfg.objective_kind == "impedance"
+    measurement = read_impedance(cfg.target_file) if impedance else read_measurement(cfg.target_file)
+    objectives = {}
+
+    def objective_of(kind: str):
+        if kind not in objectives:
+            objectives[kind] = _objective(cfg, fmu, measurement, kind)
+        return objectives[kind]
+
+    return objective_of, objectives, fmu
+
+
+def run_fit(cfg: FitConfig, fmu_dir: pathlib.Path, out_dir: pathlib.Path, seed: int,
+            stop_at: float | None = None) -> dict:
+    """Fit with cfg's method and the given seed; write result.json and figures into out_dir; return the result.
+    stop_at: the GA baseline stops when its error first reaches this value (the NNO-vs-GA comparison)."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    clock = StageClock()
+    impedance = cfg.objective_kind == "impedance"
+    objective_of, objectives, fmu = open_objectives(cfg, fmu_dir)
+    obj = objective_of(cfg.objective_kind)
+    clock.end("setup (FMU, measurement, objective)")
+    found = search(cfg, objective_of, seed, stop_at, clock)
+    res, history, ann, best_x, n_eval, stop = (found.global_result, found.history, found.ann, found.x,
+                                               found.true_evaluations, found.stop_reason)
+    final_obj = found.final_objective
     error = float(np.sum(obj.residuals(best_x) ** 2))
     ident = baselines.identifiability(final_obj.residuals, best_x, cfg.variables)
     band_error = obj.band_error_percent(best_x) if cfg.objective_kind in ("psd_band", "psd_log") else {}

@@ -14,7 +14,7 @@ from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
 from pyfit.fit.optim.baselines import polish
 from pyfit.gap import simulate as sim
-from pyfit.gap.systems import Effect, Scale, System
+from pyfit.gap.systems import Effect, Scale, System, with_derived
 
 
 @dataclass
@@ -52,6 +52,8 @@ class FitTask:
     continuation: bool = True  # envelopes first, then the lowest level, then all (see run_fit)
     log_scaled: tuple = ()  # free parameters scaled to their bounds on a log scale (positive, spanning decades)
     floor: dict | None = None  # a point the result must not be worse than (the nominal: the effect at zero)
+    derived: tuple = ()  # rules giving fixed parameters from fitted ones (systems.ExponentScaled)
+    basin_key: str | None = None  # refit from the best start of each value of this parameter (else the best)
 
 
 class UnitScaling:
@@ -95,7 +97,8 @@ def run_fit(task: FitTask) -> Fit:
     task.alternatives; with task.continuation in stages, each from the best point so far (by the residual of
     every record): the envelopes of non-periodic records (a third of the budget), the lowest level alone (a
     quarter), then every record. Never worse than the best start: each stage and the last least squares keep
-    the best point they evaluated."""
+    the best point they evaluated. With task.basin_key the same from the best start of each value of that
+    parameter (an SDOF loop, whose ν sets the scale of β, has a basin at each ν), the best result kept."""
     t0 = time.perf_counter()
     threads = max(1, min(task.threads, len(task.records)))
     runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
@@ -104,7 +107,7 @@ def run_fit(task: FitTask) -> Fit:
     unit = UnitScaling(names, task.bounds, task.log_scaled)
 
     def params(x):
-        return {**task.fixed, **unit.values(x)}
+        return with_derived({**task.fixed, **unit.values(x)}, task.derived)
 
     def residuals(p, records=task.records, of=sim.residuals):
         return _stacked(runner, records, p, task.upsample, task.lead_periods, pool, of)
@@ -112,29 +115,50 @@ def run_fit(task: FitTask) -> Fit:
     def cost(x):
         return float(np.sum(residuals(params(x)) ** 2))
 
-    # find the basin: the start with the best time-domain residual
+    # find the basins: the starts with the best time-domain residual
     candidates = [unit.scaled(task.start)] + [unit.scaled({**task.start, **alt}) for alt in task.alternatives]
     errors = [cost(x) for x in candidates]
-    x0, e0, used, budget = candidates[int(np.argmin(errors))], min(errors), len(candidates), task.budget
+    used = len(candidates)
     stages = []
     if task.continuation and not any(r.periodic for r in task.records):
         # a sweep's envelopes first (all levels): smooth in the parameters where the waveform is not
-        stages.append((task.records, sim.envelope_residuals, budget // 3))
+        stages.append((task.records, sim.envelope_residuals, 3))
     levels = sorted({r.level_value for r in task.records})
     if task.continuation and len(levels) > 1:
         # continuation in amplitude: the lowest level alone, where an amplitude-dependent effect is weakest
         # and the residual smooth in the parameters (a hardening spring jumps on a sweep at the highest level)
-        stages.append(([r for r in task.records if r.level_value == levels[0]], sim.residuals, budget // 4))
-    for records, of, part in stages:  # each stage goes on from the best point so far (on every record)
-        stage = polish(lambda x: residuals(params(x), records, of), x0, budget=part)
-        e = cost(stage.x)
-        x0, e0 = (stage.x, e) if e < e0 else (x0, e0)
-        used, budget = used + 1 + stage.n_evaluations, budget - stage.n_evaluations
-    # least squares from there; it returns the best point it evaluated, so never worse than its start
-    result = polish(lambda x: residuals(params(x)), x0, budget=budget)
-    best, error = params(result.x), result.error
+        stages.append(([r for r in task.records if r.level_value == levels[0]], sim.residuals, 4))
+
+    def descend(x0, e0, budget):
+        """The stages (each 1/part of the budget) then least squares on every record with what is left, each
+        from the best point so far; never worse than the start."""
+        n, whole = 0, budget
+        for records, of, part in stages:
+            stage = polish(lambda x: residuals(params(x), records, of), x0, budget=whole // part)
+            e = cost(stage.x)
+            x0, e0 = (stage.x, e) if e < e0 else (x0, e0)
+            n, budget = n + 1 + stage.n_evaluations, budget - stage.n_evaluations
+        result = polish(lambda x: residuals(params(x)), x0, budget=budget)
+        n += result.n_evaluations
+        return (result.x, result.error, n) if result.error <= e0 else (x0, e0, n)
+
+    # from the best start; with task.basin_key, from the best start of each of its values, each with the
+    # whole budget
+    order = np.argsort(errors)
+    if task.basin_key:
+        firsts = {}
+        for k in order:
+            firsts.setdefault(round(unit.values(candidates[k])[task.basin_key], 6), k)
+        order = sorted(firsts.values(), key=lambda k: errors[k])
+    best_x, error = None, np.inf
+    for k in order[:len(order) if task.basin_key else 1]:
+        x, e, n = descend(candidates[k], errors[k], task.budget)
+        used += n
+        if e < error:
+            best_x, error = x, e
+    best = params(best_x)
     if task.floor is not None:  # never worse than the nominal model (the effect at zero)
-        floor = {**task.fixed, **task.floor}
+        floor = with_derived({**task.fixed, **task.floor}, task.derived)
         e = float(np.sum(residuals(floor) ** 2))
         used += 1
         if e < error:
@@ -146,8 +170,8 @@ def run_fit(task: FitTask) -> Fit:
         r.close()
     if pool:
         pool.shutdown()
-    return Fit(task.effect, {k: float(v) for k, v in best.items()}, names, task.n_added, err,
-               result.n_evaluations + used, time.perf_counter() - t0)
+    return Fit(task.effect, {k: float(v) for k, v in best.items()}, names, task.n_added, err, used,
+               time.perf_counter() - t0)
 
 
 STIFFNESS_SCAN = (0.25, 0.5, 1.0, 2.0, 4.0)  # factors on the nominal stiffness tried before the least squares
@@ -213,7 +237,9 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
     floor = {**{n: nominal.params[n] for n in system.linear}, **effect.absent(scale)}
     return FitTask(fmu, tuple(records), {**system.nominal_fixed, **fixed}, start, bounds, effect.name,
                    effect.strengths, budget, upsample, system.lead_periods, tuple(alternatives),
-                   log_scaled=tuple(p.name for p in effect.params if p.log), floor=floor)
+                   log_scaled=tuple(p.name for p in effect.params if p.log), floor=floor,
+                   derived=effect.derived(scale),
+                   basin_key="nu" if effect.derived(scale) and not effect.members else None)
 
 
 def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int, effects: list,
@@ -252,6 +278,7 @@ def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, 
             # a hysteretic element or a shape parameter at its start (a hysteretic element is more than a
             # stiffness there); any other a small step from it
             p[prm.name] = st if effect.shift_stiffness > 0 or prm.shape else st + probe * (hi - st)
+        p = with_derived(p, effect.derived(scale))
         d = stacked(p) - r0
         rest, coef = unexplained(np.column_stack([J, d]))
         out[name] = 1.0 - rest / lin if lin > 0 else 0.0

@@ -203,8 +203,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             simulated(name)
         best = min(names, key=lambda n: after[n], default=None)
         excess = after[current] - floor
-        if best is None or after[best] - floor > (1.0 - cfg.min_excess_cut) * excess:
-            break
+        if best is None or after[current] <= at_noise or after[best] - floor > (1.0 - cfg.min_excess_cut) * excess:
+            break  # (the model so far, refitted on, may itself reach the noise: nothing left to add)
         current = best
     return dataclasses.replace(system, effects=effects), current
 

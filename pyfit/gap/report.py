@@ -45,7 +45,7 @@ def _gap(sims: dict, records, held, bands, floors: dict) -> dict:
 def _free_values(fit) -> dict:
     out = {n: fit.params[n] for n in fit.free}
     if "hysteresis" in fit.effect.split(" + ") and "delta" in fit.free:  # the SDOF form: β·γ, β·δ identifiable
-        out["beta (fixed)"] = fit.params["beta"]
+        out["beta (set by nu)"] = fit.params["beta"]
         out["beta*gamma"] = fit.params["beta"] * fit.params["gamma"]
         out["beta*delta"] = fit.params["beta"] * fit.params["delta"]
     return out
@@ -199,10 +199,10 @@ def separation(runner, result, records, fits, bands, upsample, lead_periods=1) -
 
 
 def write(result: dict, records, held, sims, bands, out_dir) -> pathlib.Path:
-    """report.json, report.md, gap_map.png (band x level, nominal model) and overlay.png (held-out file)."""
+    """report.json, report.md, gap_map.png (band x level, nominal model), overlay.png (held-out file), and
+    where they apply envelopes.png (sweeps) and loops.png (a force-driven SDOF)."""
 
     out = pathlib.Path(out_dir)
-    (out / "report.json").write_text(json.dumps(result, indent=1))
     # gap map: the nominal model's misfit per band (rows) and file (columns)
     M = np.array([[np.nan] * len(bands) if sims["nominal"][r.name] is None
                   else localise.by_band(sims["nominal"][r.name], r, bands) for r in records]).T
@@ -223,9 +223,79 @@ def write(result: dict, records, held, sims, bands, out_dir) -> pathlib.Path:
                            "-"))
     plots.semilogy_curves(out / "overlay.png", curves, "frequency [Hz]", f"|DFT| of {k} [SI]",
                           f"held-out file {rec.name}: output and residual spectra")
+    models = ["nominal"] + ([best] if best else [])
+    result["extra_figures"] = []
+    if not any(r.periodic for r in records):
+        _envelopes(out / "envelopes.png", records, sims, models, k)
+        result["extra_figures"].append("envelopes")
+    if "u" in records[0].inputs and "m" in result["nominal"]["params"] and k in ("y", "v", "a"):
+        _restoring_force_loops(out / "loops.png", records, sims, models, k, result["nominal"]["params"]["m"])
+        result["extra_figures"].append("loops")
+    (out / "report.json").write_text(json.dumps(result, indent=1))
     md = out / "report.md"
     md.write_text(markdown(result))
     return md
+
+
+UNITS = {"y": "m", "v": "m/s", "a": "m/s²", "x1": "m", "x2": "m"}  # of the outputs the figures label
+
+
+def _instantaneous_frequency(u: np.ndarray, fs: float) -> np.ndarray:
+    """The input's instantaneous frequency [Hz]: the rate of its analytic signal's phase, smoothed over 0.5 s."""
+    import scipy.signal
+
+    phase = np.unwrap(np.angle(scipy.signal.hilbert(u - np.mean(u))))
+    f = np.gradient(phase) * fs / (2 * np.pi)
+    n = max(int(0.5 * fs), 1)
+    return np.convolve(f, np.ones(n) / n, mode="same")
+
+
+def _envelopes(path, records, sims, models, k) -> None:
+    """Per level of a sweep: the output's envelope against the input's instantaneous frequency, measured and
+    simulated by each of `models` (the nominal and the chosen effect)."""
+    panels = []
+    for rec in records:
+        f = _instantaneous_frequency(next(iter(rec.inputs.values()))[rec.first:], rec.fs)
+        inner = slice(int(0.5 * rec.fs), rec.n - int(0.5 * rec.fs))  # the smoothing's edges left out
+        curves = [("measured", f[inner], sim.envelope(rec.outputs[k], rec.fs)[inner])]
+        curves += [(name, f[inner], sim.envelope(sims[name][rec.name][k], rec.fs)[inner]) for name in models
+                   if sims[name].get(rec.name) is not None]
+        panels.append((rec.level, curves))
+    name = f"envelope of {k}"
+    plots.loops(path, panels, "input frequency", name, {"input frequency": "Hz", name: UNITS.get(k, "SI")},
+                "response envelope against the input's instantaneous frequency, per level")
+
+
+def restoring_force(u: np.ndarray, recorded: np.ndarray, kind: str, fs: float, mass: float, periodic: bool,
+                    window: slice) -> tuple[np.ndarray, np.ndarray]:
+    """Displacement y [m] and restoring force u - m·a [N] over `window`, y and a derived from the recorded
+    output of `kind` ('x', 'v' or 'a'; pyfit.analysis.kinematics, band-limited to the excited band's lower
+    edge and 0.4 fs so that the harmonics stay)."""
+    from pyfit.analysis import kinematics
+
+    band = (kinematics.excited_band(u, fs)[0], 0.4 * fs)
+    full = kinematics.complete({kind: recorded}, fs, band, periodic=periodic)
+    return full["x"][window], (u - mass * full["a"])[window]
+
+
+def _restoring_force_loops(path, records, sims, models, k, mass: float) -> None:
+    """Per level: the restoring force against the displacement over a period either side of the largest
+    response (for a sweep: at the resonance), measured and simulated by each of `models`; m is the nominal
+    calibration's mass."""
+    kind = {"y": "x", "v": "v", "a": "a"}[k]
+    panels = []
+    for rec in records:
+        u = rec.compared("u")
+        peak = int(np.argmax(sim.envelope(rec.outputs[k], rec.fs)))
+        f = max(float(_instantaneous_frequency(u, rec.fs)[peak]), 1.0)
+        half = int(rec.fs / f)
+        window = slice(max(peak - half, 0), min(peak + half, rec.n))
+        curves = [(name, *restoring_force(u, y, kind, rec.fs, mass, rec.periodic, window))
+                  for name, y in [("measured", rec.outputs[k])] + [(n, sims[n][rec.name][k]) for n in models
+                                                                   if sims[n].get(rec.name) is not None]]
+        panels.append((rec.level, curves))
+    plots.loops(path, panels, "y", "u - m a", {"y": "m", "u - m a": "N"},
+                "restoring force against displacement at the largest response, per level")
 
 
 def markdown(result: dict) -> str:
@@ -280,4 +350,5 @@ def markdown(result: dict) -> str:
         lines += ["", "| loop region (held out) | NRMSE contribution |", "|---|---|"]
         lines += [f"| {k} | {v:.4f} |" for k, v in g["by_loop_region"].items()]
     lines += ["", "![gap map](gap_map.png)", "", "![overlay](overlay.png)", ""]
+    lines += [f"![{name}]({name}.png)\n" for name in result.get("extra_figures", [])]
     return "\n".join(lines)

@@ -40,6 +40,28 @@ class Param:
 
 
 @dataclass(frozen=True)
+class ExponentScaled:
+    """A fixed parameter whose unit depends on a fitted exponent: target = value · reference^(1 − exponent).
+    The SDOF Bouc-Wen β [m⁻¹·N^(1−ν)] (theory §1.1): value 1/σ_y and reference the force k·σ_y keep
+    β·|z|^ν / α of order one at the data's deflection for every ν, so γ and δ stay of order one."""
+
+    target: str
+    value: float
+    reference: float
+    exponent: str
+
+    def __call__(self, params: dict) -> dict:
+        return {**params, self.target: self.value * self.reference ** (1.0 - params[self.exponent])}
+
+
+def with_derived(params: dict, rules: tuple) -> dict:
+    """params with every rule (e.g. ExponentScaled) applied in turn."""
+    for rule in rules:
+        params = rule(params)
+    return params
+
+
+@dataclass(frozen=True)
 class Effect:
     """A candidate unmodelled effect: its free parameters, the fixed values that switch it on, the signature
     it leaves (used as evidence in the report), and other starts of its shape parameters spanning the family
@@ -53,6 +75,7 @@ class Effect:
     starts: callable = field(default=lambda s: [])
     members: tuple = ()  # the single effects of a combination (see `combine`); () for a single effect
     signal_only: bool = False  # acts on the recorded channels, not in the FMU (pyfit.gap.simulate applies it)
+    derived: callable = field(default=lambda s: ())  # Scale -> rules giving fixed values from fitted ones
 
     @property
     def strengths(self) -> int:
@@ -100,7 +123,8 @@ def combine(effects: list[Effect]) -> Effect:
                   fixed=lambda s: {k: v for e in effects for k, v in e.fixed(s).items()},
                   signature="; ".join(f"{e.name}: {e.signature}" for e in effects),
                   shift_stiffness=max(e.shift_stiffness for e in effects),
-                  starts=lambda s: [st for e in effects for st in e.starts(s)], members=tuple(names))
+                  starts=lambda s: [st for e in effects for st in e.starts(s)], members=tuple(names),
+                  derived=lambda s: tuple(r for e in effects for r in e.derived(s)))
 
 
 def _sym(scale_fn):
@@ -183,7 +207,7 @@ def sdof_stiffness(params: dict) -> float:
 _stick_velocity = Param("v_s", lambda s: (1e-3 * s.sigma_v, 1e-2 * s.sigma_v, 0.5 * s.sigma_v), shape=True, log=True)
 
 # Shapes of the Bouc-Wen loop the refit starts from, spanning the family (theory §1.1 and §1.3): with β fixed
-# at 1/sigma_y (SDOF) or D at sigma_y (damper), the loading branch softens when γ + δ > 0 (SDOF) or β + γ > 0
+# at (1/sigma_y)·(k·sigma_y)^(1-ν) (SDOF) or D at sigma_y (damper), the loading branch softens when γ + δ > 0 (SDOF) or β + γ > 0
 # (damper) and hardens otherwise; the unloading branch likewise with γ - δ or β - γ; ν from 1 (smooth) to
 # 3 (sharp). The refit begins from the best of them on the calibration records and fits the shape.
 SDOF_LOOP_STARTS = ({"gamma": 0.5, "delta": 0.5, "nu": 1.0},    # softening on both branches, wide loop
@@ -220,7 +244,7 @@ SDOF_EFFECTS = {
          Param("gamma", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["gamma"], 5.0)),
          Param("delta", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["delta"], 5.0)),
          Param("nu", shape=True, range=lambda s: (1.0, SDOF_LOOP_STARTS[0]["nu"], 3.0))),
-        fixed=lambda s: {"beta": 1.0 / s.sigma_y},
+        derived=lambda s: (ExponentScaled("beta", 1.0 / s.sigma_y, HYSTERETIC_FRACTIONS[1] * s.k * s.sigma_y, "nu"),),
         signature="amplitude-dependent stiffness and damping (hysteresis loops), odd distortion",
         shift_stiffness=0.1, starts=lambda s: _sdof_loop_starts(s)),
     "cubic_stiffness": Effect(

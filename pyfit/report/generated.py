@@ -73,6 +73,10 @@ RESULTS = {
     "docs/results/bench_eval_speed.md": ("results/bench/eval_speed.md", "python bench/eval_speed.py"),
     "docs/results/bench_diagnose_time.md": ("results/bench/diagnose_time.md", "python bench/diagnose_time.py"),
     "docs/results/bench_fit_time.md": ("results/bench/fit_time.md", "python bench/fit_time.py"),
+    "docs/results/campaign.md": ("results/campaign/summary.md",
+                                 "stockbridge diagnose --campaign 20 --out results/campaign"),
+    "docs/results/bench_peers_fit.md": ("results/bench/peers_fit.md", "python bench/peers_fit.py"),
+    "docs/results/bench_peers_diagnosis.md": ("results/bench/peers_diagnosis.md", "python bench/peers_diagnosis.py"),
     "docs/results/design_check.md": ("results/design_check/design_check.md",
                                      "stockbridge design-check configs/span_drake_300m.toml"),
     "docs/results/verify_balance.md": ("results/verify_balance/verify_balance.md", "stockbridge verify-balance"),
@@ -200,15 +204,24 @@ def headlines(root: pathlib.Path) -> pathlib.Path:
 
 
 class BenchReport:
-    """What a bench/ script prints, also written to results/bench/<name>.md (one line per figure)."""
+    """What a bench/ script prints, also written to results/bench/<name>.md (one line per figure, or tables)."""
 
     def __init__(self, name: str, root: pathlib.Path | None = None):
         self.path = (root or pathlib.Path.cwd()) / "results" / "bench" / f"{name}.md"
-        self.lines: list[str] = []
+        self.blocks: list[str] = []
+
+    def _keep(self, text: str) -> None:
+        print(text, flush=True)
+        self.blocks.append(text)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.path.write_text("".join(self.blocks), encoding="utf-8")
 
     def line(self, text: str) -> None:
         """Print one result line and keep it for the file."""
-        print(text, flush=True)
-        self.lines.append(text)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.path.write_text("".join(f"- {t}\n" for t in self.lines), encoding="utf-8")
+        self._keep(f"- {text}\n")
+
+    def table(self, title: str, header: list[str], rows: list[list]) -> None:
+        """Print a Markdown table under a bold title and keep it for the file."""
+        lines = [f"\n**{title}**\n", "", "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+        lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+        self._keep("\n".join(lines) + "\n")

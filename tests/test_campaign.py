@@ -1,0 +1,56 @@
+"""The validation campaign (pyfit.gap.campaign): its draw and its summary; the short campaign itself (20 random
+cases written by the CasADi reference and diagnosed on a Dask LocalCluster) is in the slow tier."""
+import json
+
+import numpy as np
+import pytest
+
+from pyfit.gap import campaign
+from pyfit.gap.systems import SDOF_EFFECTS, Scale
+
+
+def test_the_draw_is_reproducible_and_spans_nulls_singles_and_pairs():
+    a, b = campaign.draw(200, seed=3), campaign.draw(200, seed=3)
+    assert a == b
+    kinds = [0 if c.withheld == "none" else len(c.withheld.split("+")) for c in a]
+    # shares 0.2 / 0.6 / 0.2: binomial standard deviation of a count of 200 is at most 7
+    assert abs(kinds.count(0) - 40) < 4 * 7 and abs(kinds.count(1) - 120) < 4 * 7 and abs(kinds.count(2) - 40) < 4 * 7
+    assert {c.excitation for c in a} == {"multisine", "sweep"} and {c.output for c in a} == {"y", "a"}
+    assert {c.truth["nu"] for c in a if "nu" in c.truth} == {1.0, 2.0, 3.0}
+
+
+def test_no_drawn_loop_sits_at_a_start_of_the_candidate():
+    scale = Scale(1e-3, 0.2, 1e5, {})
+    effect = SDOF_EFFECTS["hysteresis"]
+    starts = [{p.name: p.range(scale)[1] for p in effect.params}] + effect.starts(scale)
+    loops = [c.truth for c in campaign.draw(200, seed=4) if "gamma" in c.truth]
+    for loop in loops:
+        assert all(abs(loop["gamma"] - s["gamma"]) > 1e-6 or abs(loop["delta"] - s["delta"]) > 1e-6 for s in starts)
+
+
+def test_the_summary_counts_what_was_named_against_what_was_withheld():
+    outcomes = [{"withheld": "hysteresis", "named": "hysteresis", "enr": 30.0, "top_shrink_pct": 99.0},
+                {"withheld": "hysteresis", "named": "cubic_stiffness", "enr": 3.0, "top_shrink_pct": 60.0},
+                {"withheld": "cubic_stiffness", "named": "none", "enr": 1.0, "top_shrink_pct": None},
+                {"withheld": "none", "named": "none", "enr": 0.9, "top_shrink_pct": None},
+                {"withheld": "none", "named": "coulomb_friction", "enr": 1.5, "top_shrink_pct": 55.0}]
+    for o in outcomes:
+        o.update(data_s=1.0, diagnose_s=2.0)
+    s = campaign.summarise(outcomes)
+    assert s["confusion"]["hysteresis"] == {"coulomb_friction": 0, "cubic_stiffness": 1, "hysteresis": 1, "none": 0}
+    assert s["top1"] == pytest.approx(1 / 3) and s["false_alarms"] == 1 and s["null_cases"] == 2
+    assert [b["cases"] for b in s["by_enr"]] == [1, 1, 0, 0, 1]
+    assert [(b["named"], b["right"]) for b in s["by_shrink"]] == [(0, 0), (2, 0), (0, 0), (1, 1)]
+
+
+@pytest.mark.slow
+def test_a_short_campaign_on_a_local_dask_cluster(tmp_path, fmu_dir, measured):
+    summary = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)
+    measured("short campaign (20 random SDOF cases): top-1 accuracy on cases with a withheld effect",
+             summary["top1"], 0.6, at_least=True)
+    measured("short campaign: false alarms on the null cases", summary["false_alarms"], 0)
+    assert summary["errors"] == 0
+    again = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)  # resumes: nothing redone
+    assert again["wall_s"] < 0.1 * summary["wall_s"]
+    assert json.loads((tmp_path / "summary.json").read_text())["cases"] == 20
+    assert np.isfinite(summary["median_case_s"])
