@@ -55,17 +55,20 @@ def build_fmu(model_name: str, out_dir: pathlib.Path, ident: str | None = None,
 
 def build_all(out_dir: pathlib.Path, names: list[str] | None = None, library: pathlib.Path = LIBRARY,
               on_built=None) -> list[BuildResult]:
-    """Build every exported example (or the ones named); the library is checked before anything is written."""
+    """Build every exported example (or the ones named: an example's name, or any class's full name in
+    `library`, a folder or a list of folders); the library is checked before anything is written."""
     from pyfit.build import frontend
 
     frontend.parse_library(library)
     names = names or list(EXAMPLES)
-    unknown = [n for n in names if n not in EXAMPLES]
+    unknown = [n for n in names if n not in EXAMPLES and "." not in n]
     if unknown:
-        raise ValueError(f"unknown example(s) {unknown}; valid: {sorted(EXAMPLES)}")
+        raise ValueError(f"unknown example(s) {unknown}; valid: {sorted(EXAMPLES)}, or a class's full name "
+                         "(e.g. MyDampers.SDOFMaxwell, with its library given)")
     results = []
     for n in names:
-        r = build_fmu(EXAMPLES[n], out_dir, n, library)
+        r = build_fmu(EXAMPLES[n], out_dir, n, library) if n in EXAMPLES else \
+            build_fmu(n, out_dir, n.split(".")[-1], library)
         results.append(r)
         if on_built:
             on_built(r)

@@ -53,15 +53,18 @@ class FlatModel:
     input_derivatives: dict[str, str] = field(default_factory=dict)  # input -> input that is its derivative
 
 
-def parse_library(library: pathlib.Path):
-    """Parse every .mo file below `library` into one pymoca tree.
+def parse_library(library):
+    """Parse every .mo file below `library` (a folder, or a list of folders: e.g. this library and yours)
+    into one pymoca tree.
 
     A syntax error raises ModelicaError naming the file and the line.
     """
-    library = pathlib.Path(library)
-    files = sorted(library.rglob("*.mo"))
-    if not files:
-        raise ModelicaError(f"{library}: no .mo files found")
+    files = []
+    for folder in (library if isinstance(library, (list, tuple)) else [library]):
+        found = sorted(pathlib.Path(folder).rglob("*.mo"))
+        if not found:
+            raise ModelicaError(f"{folder}: no .mo files found")
+        files += found
     tree = None
     for path in files:
         try:
@@ -104,8 +107,9 @@ def _find_class(tree, dotted: str):
     return node
 
 
-def load(library: pathlib.Path, model_name: str) -> FlatModel:
-    """Flatten `model_name` (for example 'StockbridgeDamper.Examples.SDOFBoucWen') from the library folder."""
+def load(library, model_name: str) -> FlatModel:
+    """Flatten `model_name` (for example 'StockbridgeDamper.Examples.SDOFBoucWen') from the library folder (or
+    folders)."""
     tree = parse_library(library)
     original = _find_class(tree, model_name)
     annotation = _annotation_to_dict(original.annotation)

@@ -9,6 +9,7 @@ import sys
 EXAMPLE = """examples:
   stockbridge diagnose --model damper --data my_sweeps/ --nominal my_damper.toml --out results/diagnose
   stockbridge diagnose --model sdof --data my_tests/
+  stockbridge diagnose --model sdof --data my_tests/ --candidates my_candidates.toml  # your own effects too
   stockbridge diagnose --impedance damper_test.csv --uncertainty 0.01      # an IEC 61897 impedance test
   stockbridge diagnose --make-datasets cases/ --excitation sweep --record a # withheld-effect test cases
   stockbridge diagnose --cases cases/ --out results/cases                   # every dataset under cases/
@@ -27,6 +28,8 @@ def add_arguments(ap) -> None:
     ap.add_argument("--config", help="TOML with a [diagnose] table")
     ap.add_argument("--nominal", help="TOML describing your system: [nominal] family, fixed and free parameters "
                                       "(default: the FMU's own; for the damper the reference damper)")
+    ap.add_argument("--candidates", help="TOML declaring your own candidate effects (FMU parameters, bounds, start "
+                                         "rules) and the FMU that holds them; docs: gap diagnosis")
     ap.add_argument("--out", default="results/diagnose")
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument("--fmus", default="fmus")
@@ -87,7 +90,8 @@ def run(args, ap) -> int:
                 args.data = benchmark_data.write_dataset(pathlib.Path(args.out) / "data")
             if not args.data:
                 ap.error("--data is required (or --impedance, --benchmark, --make-datasets, --cases)")
-            report = diagnose(args.model, args.data, args.out, cfg, args.fmus, args.workers, nominal=args.nominal)
+            report = diagnose(args.model, args.data, args.out, cfg, args.fmus, args.workers, nominal=args.nominal,
+                              candidates=args.candidates)
     except (ConfigError, ValueError, FileNotFoundError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

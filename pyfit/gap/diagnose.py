@@ -18,7 +18,7 @@ from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
 from pyfit.runtime.examples import ensure_fmu
 from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read_toml
-from pyfit.gap import localise, selection
+from pyfit.gap import localise, selection, user_candidates
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import Fit, effect_task, nominal_task, run_fit, screen
 from pyfit.gap.systems import combine, family_fmu, make_system
@@ -215,20 +215,36 @@ def fmu_defaults(runner: FmuRunner) -> dict[str, float]:
             if v.causality == "parameter" and v.start is not None and v.type == "Real"}
 
 
+def _with_user_candidates(system, users, fmu_parameters: set):
+    """The system with the user's declared candidates among its effects (checked against the FMU)."""
+    for name, effect in users.effects.items():
+        if name in system.effects:
+            raise DiagnoseError(f"{users.path}: candidate '{name}' is a built-in candidate; give it another name")
+        missing = [p for p in [q.name for q in effect.params] + list(effect.fixed(None)) if p not in fmu_parameters]
+        if missing:
+            raise DiagnoseError(f"{users.path}: candidate '{name}': '{missing[0]}' is not a parameter of the FMU "
+                                f"({users.fmu or system.fmu}); allowed: {', '.join(sorted(fmu_parameters))}")
+    return dataclasses.replace(system, effects={**system.effects, **users.effects})
+
+
 def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, fmu_dir="fmus",
-             workers: int | None = None, progress: bool = True, nominal: NominalModel | str | None = None) -> dict:
+             workers: int | None = None, progress: bool = True, nominal: NominalModel | str | None = None,
+             candidates=None) -> dict:
     """Diagnose the dataset against the nominal model `model` ('sdof' or 'damper'); writes OUT/report.json,
     OUT/report.md and figures; returns the report. When the nominal model already fits the held-out files
     within the noise floor, no effect is refitted (verdict 'no significant gap').
 
     nominal: the user's description of the nominal model (a NominalModel or a TOML file, see
-    pyfit.io.nominal); None: the FMU's defaults (for the damper, the theory §1.3 reference damper)."""
+    pyfit.io.nominal); None: the FMU's defaults (for the damper, the theory §1.3 reference damper).
+    candidates: the user's declared candidate effects (pyfit.gap.user_candidates, or its TOML file): screened,
+    refitted and ranked with the built-in ones, in the FMU the file names."""
     from pyfit.gap import report
 
     clock = StageClock()
 
     cfg = cfg or DiagnoseConfig()
-    fmu = str(ensure_fmu(family_fmu(model), pathlib.Path(fmu_dir)))
+    users = user_candidates.load(candidates) if isinstance(candidates, (str, pathlib.Path)) else candidates
+    fmu = str(users.fmu) if users and users.fmu else str(ensure_fmu(family_fmu(model), pathlib.Path(fmu_dir)))
     runner = FmuRunner(fmu)
     described = load_nominal(nominal) if isinstance(nominal, (str, pathlib.Path)) else nominal
     if described is not None:
@@ -237,6 +253,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
                                 f"of '{model}'")
         described.check_names(set(runner.parameter_names()))
     system = make_system(model, fmu_defaults(runner), described)
+    if users:
+        system = _with_user_candidates(system, users, set(runner.parameter_names()))
     records, cal, held, data_key, level_order = _load(data_dir, system, cfg, runner)
     lo, hi = localise.excited_range(records)
     modes = linear_modes(fmu, {**system.nominal_fixed, **system.start(cal)})
@@ -253,8 +271,9 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in judging}, sort_keys=True)
     description = json.dumps({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}
                              if described else {}, sort_keys=True)
-    key = hashlib.sha256((data_key + settings + model + description + ",".join(r.name for r in cal)).encode()
-                         ).hexdigest()[:16]
+    declared = users.text + hashlib.sha256(pathlib.Path(fmu).read_bytes()).hexdigest() if users else ""
+    key = hashlib.sha256((data_key + settings + model + description + declared + ",".join(r.name for r in cal)
+                          ).encode()).hexdigest()[:16]
 
     nominal = _stored(out / "fits" / "nominal.json", key)
     if nominal is None:
