@@ -10,6 +10,8 @@ The peers are an optional extra: pip install -e ".[peers]".
     python bench/peers_fit.py --quick    # the SDOF wide and damper studies, 1 seed, a few minutes
 """
 import argparse
+import dataclasses
+import json
 import pathlib
 import sys
 import warnings
@@ -52,9 +54,11 @@ def main():
         for done in as_completed([pool.submit(_one, job) for job in jobs]):
             runs += done.result()
             print(f"{runs[-1].problem} seed {runs[-1].seed} done ({time.perf_counter() - t0:.0f} s)", flush=True)
-    report.line(f"{len(problems)} problems x {seeds} seeds; command: python bench/peers_fit.py"
-                f"{' --quick' if args.quick else ''}; {args.workers} worker processes, wall "
+    command = "python bench/peers_fit.py" + (" --quick" if args.quick else "") + \
+        (f" --seeds {args.seeds}" if not args.quick and args.seeds != 5 else "")
+    report.line(f"{len(problems)} problems x {seeds} seeds; command: {command}; {args.workers} worker processes, wall "
                 f"{(time.perf_counter() - t0) / 60:.0f} min; Python {sys.version.split()[0]}")
+    (report.path.with_suffix(".json")).write_text(json.dumps([dataclasses.asdict(r) for r in runs], indent=1))
     for problem in problems:
         header, rows = peers.table([r for r in runs if r.problem == problem])
         report.table(f"{problem} (configs/{problem}.toml)", header, rows)

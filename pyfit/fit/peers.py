@@ -270,7 +270,9 @@ def _median(values) -> float | None:
 
 
 def _pct(v: float | None) -> str:
-    return "—" if v is None else f"{100 * v:.2g} %" if v < 10 else f"{100 * v:.0f} %"
+    if v is None:
+        return "—"
+    return f"{100 * v:.2g} %" if 100 * v < 10 else f"{100 * v:.0f} %"
 
 
 def table(runs: list[PeerRun]) -> tuple[list[str], list[list]]:
@@ -300,13 +302,17 @@ def table(runs: list[PeerRun]) -> tuple[list[str], list[list]]:
             ratio = f"> {budget / nno:.2g} (not within {budget})"
         else:
             ratio = "—"
+        if tool == NNO:
+            note = f"its own: {_median(r.evaluations for r in ran):.0f} evaluations (median)"
+        else:
+            cut = sum(r.evaluations < r.budget for r in ran)
+            note = f"{budget} evaluations" + (f"; {cut} of {len(ran)} runs stopped earlier, at NNO's wall time "
+                                              f"({_median(r.evaluations for r in ran):.0f} evaluations, median)"
+                                              if cut else "")
         rows.append([tool, ran[0].objective, f"{len(hits)}/{len(ran)}", "—" if evals is None else f"{evals:.0f}",
                      "—" if not hits else f"{_median(r.to_target_s for r in hits):.0f}",
                      _pct(_median(r.final_recovery for r in ran)),
                      "—" if tool == NNO else _pct(_median(r.recovery_at_nno_evaluations for r in ran)),
                      "—" if tool == NNO else _pct(_median(r.recovery_at_nno_wall for r in ran)),
-                     ratio, f"{budget} evaluations" + (f" (median {_median(r.evaluations for r in ran):.0f}: "
-                                                       f"stopped at NNO's wall time)" if WALL_FACTOR == 1 else f"stopped at {WALL_FACTOR:g}x NNO's wall time)"
-                                                       if any(r.evaluations < budget for r in ran) else "")
-                     + (f"; {ran[0].note}" if ran[0].note else "")])
+                     ratio, note + (f"; {ran[0].note}" if ran[0].note else "")])
     return header, rows
