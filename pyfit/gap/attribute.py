@@ -239,7 +239,7 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
                    effect.strengths, budget, upsample, system.lead_periods, tuple(alternatives),
                    log_scaled=tuple(p.name for p in effect.params if p.log), floor=floor,
                    derived=effect.derived(scale),
-                   basin_key="nu" if effect.derived(scale) and not effect.members else None)
+                   basin_key=effect.basin_key)
 
 
 def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int, effects: list,

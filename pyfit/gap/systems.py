@@ -42,7 +42,7 @@ class Param:
 @dataclass(frozen=True)
 class ExponentScaled:
     """A fixed parameter whose unit depends on a fitted exponent: target = value · reference^(1 − exponent).
-    The SDOF Bouc-Wen β [m⁻¹·N^(1−ν)] (theory §1.1): value 1/σ_y and reference the force k·σ_y keep
+    The SDOF Bouc-Wen β [m⁻¹·N^(1−ν)] (theory §1.1): value 1/σ_y and reference the force 0.3·k·σ_y keep
     β·|z|^ν / α of order one at the data's deflection for every ν, so γ and δ stay of order one."""
 
     target: str
@@ -76,6 +76,7 @@ class Effect:
     members: tuple = ()  # the single effects of a combination (see `combine`); () for a single effect
     signal_only: bool = False  # acts on the recorded channels, not in the FMU (pyfit.gap.simulate applies it)
     derived: callable = field(default=lambda s: ())  # Scale -> rules giving fixed values from fitted ones
+    basin_key: str | None = None  # a shape parameter with a basin at each of its start values (refit from each)
 
     @property
     def strengths(self) -> int:
@@ -245,6 +246,7 @@ SDOF_EFFECTS = {
          Param("delta", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["delta"], 5.0)),
          Param("nu", shape=True, range=lambda s: (1.0, SDOF_LOOP_STARTS[0]["nu"], 3.0))),
         derived=lambda s: (ExponentScaled("beta", 1.0 / s.sigma_y, HYSTERETIC_FRACTIONS[1] * s.k * s.sigma_y, "nu"),),
+        basin_key="nu",
         signature="amplitude-dependent stiffness and damping (hysteresis loops), odd distortion",
         shift_stiffness=0.1, starts=lambda s: _sdof_loop_starts(s)),
     "cubic_stiffness": Effect(
