@@ -131,3 +131,20 @@ def test_a_killed_batch_leaves_no_worker_processes(tmp_path, sig, measured):
     measured(f"batch killed with {signal.Signals(sig).name} inside 300 s tasks: time until no worker runs [s]",
              time.monotonic() - t0, 5.0)
     assert not any(_alive(w) for w in workers)
+
+
+def test_fmus_loaded_from_many_threads_leave_the_working_directory_alone(fmu_dir):
+    """fmpy moves the process into the FMU's binaries folder while it loads the library; unguarded, two threads
+    loading at once can leave the process in an extracted folder that close() deletes."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    here = os.getcwd()
+
+    def load_and_close(_):
+        runner = FmuRunner(str(fmu_dir / "SDOFBoucWen.fmu"))
+        runner.instance()
+        runner.close()
+
+    with ThreadPoolExecutor(8) as pool:
+        list(pool.map(load_and_close, range(32)))
+    assert os.getcwd() == here

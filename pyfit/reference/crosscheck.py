@@ -20,7 +20,7 @@ from fmpy.fmi2 import FMU2Model
 
 from pyfit.analysis import signals
 from pyfit.analysis.excitation import Excitation, multisine
-from pyfit.runtime.fmu import FmuRunner
+from pyfit.runtime.fmu import FmuRunner, load_fmu
 from pyfit.reference import integrate
 from pyfit.reference import models
 
@@ -76,8 +76,8 @@ class _MEProbe:
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
         self.types = {v.name: v.type for v in self.md.modelVariables}
         self.dir = extract(str(path))
-        self.fmu = FMU2Model(guid=self.md.guid, unzipDirectory=self.dir,
-                             modelIdentifier=self.md.modelExchange.modelIdentifier, instanceName="probe")
+        self.fmu = load_fmu(FMU2Model, guid=self.md.guid, unzipDirectory=self.dir,
+                            modelIdentifier=self.md.modelExchange.modelIdentifier, instanceName="probe")
         self.fmu.instantiate()
         self.fmu.setupExperiment(startTime=0.0)
         params = dict(params, exc_type=0)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import ctypes
 import pathlib
 import shutil
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,6 +22,17 @@ from fmpy.fmi1 import FMICallException
 from pyfit.runtime.native import cs_loop
 from fmpy.fmi2 import (FMU2Model, FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
+
+
+_LOADING = threading.Lock()
+
+
+def load_fmu(cls, **kwargs):
+    """An fmpy FMU object (cls: FMU2Model, FMU2Slave, ...) built while no other thread builds one: fmpy changes
+    the process's working directory to the FMU's binaries folder while it loads the library and back after,
+    so two threads loading at once can leave the process in a folder that is deleted later."""
+    with _LOADING:
+        return cls(**kwargs)
 
 
 class ParameterError(ValueError):
@@ -92,7 +104,7 @@ class FmuRunner:
             unzip = extract(self.path)
             cls = FMU2Slave if self.interface == "CoSimulation" else FMU2Model
             ident = (md.coSimulation if self.interface == "CoSimulation" else md.modelExchange).modelIdentifier
-            fmu = cls(guid=md.guid, unzipDirectory=unzip, modelIdentifier=ident, instanceName="pyfit")
+            fmu = load_fmu(cls, guid=md.guid, unzipDirectory=unzip, modelIdentifier=ident, instanceName="pyfit")
             log: list[str] = []
             callbacks = _collecting_callbacks(log)
             fmu.instantiate(callbacks=callbacks)
