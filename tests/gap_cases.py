@@ -2,7 +2,9 @@
 from pyfit.gap import datasets
 from pyfit.gap import diagnose as dg
 
-CI = dg.DiagnoseConfig(nominal_budget=30, refit_budget=60)
+# CI budgets: fewer evaluations per fit, and the forward selection from the best single effect only with three
+# partners (the default search, two starts and every partner, runs in the slow tier and the campaign)
+CI = dg.DiagnoseConfig(nominal_budget=30, refit_budget=60, beam=1, partners=3)
 
 
 def case(root, effect, seed=0):

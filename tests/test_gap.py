@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from gap_cases import CI, case
+from pyfit.gap import confidence
 from pyfit.gap import diagnose as dg
 
 F0 = np.sqrt(1e5 / 2.0) / (2 * np.pi)  # 35.6 Hz, the truth's linear resonance
@@ -47,8 +48,14 @@ def test_chosen_effect_recovers_the_withheld_strength(data_root, fmu_dir, effect
     # the refit's strength against the truth's (k3 = 3e8 N/m^3, F_c = 1 N, c2 = 10 N·s²/m²); the friction's
     # smoothing velocity v_s is fitted with F_c (log-scaled) but barely shapes these displacement records
     truth = json.loads((case(data_root, effect) / "truth.json").read_text())["params"][strength]
-    best = json.loads((_diagnosed(data_root, fmu_dir, effect) / "report.json").read_text())["ranking"][0]
-    assert best["effect"] == effect
+    out = _diagnosed(data_root, fmu_dir, effect)
+    rep = json.loads((out / "report.json").read_text())
+    best = rep["ranking"][0]
+    assert best["effect"] == effect and best["shrink_pct"] >= 95.0  # measured 100 % on each
+    # the confidence the package's campaign calibration gives a report that removed 95 % or more, stated
+    conf = rep["confidence"]
+    assert conf["of"] > 0 and "≥ 95" in conf["alike"] and conf["low"] <= conf["rate"] <= conf["high"]
+    assert confidence.Confidence(**conf).sentence() in (out / "report.md").read_text()
     measured(f"SDOF gap diagnosis, {effect} withheld (CI budgets): |fitted {strength} / truth − 1|",
              abs(best["params"][strength] / truth - 1), 0.02)
 

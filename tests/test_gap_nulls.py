@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from gap_cases import CI, case
+from pyfit.gap import confidence
 from pyfit.gap import diagnose as dg
 
 
@@ -19,6 +20,10 @@ def test_null_dataset_gives_no_false_alarm(data_root, fmu_dir, seed, measured):
     rep = dg.diagnose("sdof", case(data_root, "none", seed), data_root / f"out_none{seed}", CI, fmu_dir,
                       workers=2, progress=False)
     assert rep["verdict"] == "no significant gap" and rep["chosen_effect"] is None
+    # the confidence the package's campaign calibration gives this verdict, stated in the report
+    conf = rep["confidence"]
+    assert conf["of"] > 0 and "no significant gap" in conf["alike"] and conf["low"] <= conf["rate"] <= conf["high"]
+    assert confidence.Confidence(**conf).sentence() in (data_root / f"out_none{seed}" / "report.md").read_text()
     # the nominal fit sits on the noise floor the data give (5e-6 m noise, about 0.4 % of the output RMS)
     measured(f"SDOF gap diagnosis, null dataset seed {seed} ('no significant gap'): |held-out gap / noise floor − 1|",
              abs(rep["gap"]["overall"] / rep["gap"]["noise_floor"] - 1), 0.1)

@@ -51,6 +51,8 @@ def add_arguments(ap) -> None:
                     "(effects, pairs, nulls; strengths, loop shapes, excitation, sensor), write and diagnose each, "
                     "summarise (confusion matrix, detection limit, false alarms) in OUT/summary.md; resumes")
     ap.add_argument("--campaign-seed", type=int, default=0, help="with --campaign: the draw's seed")
+    ap.add_argument("--calibrate", action="store_true", help="with --campaign: its hit rates become the confidence "
+                    "every later report states (stored in the package: pyfit/gap/calibration.json)")
     ap.add_argument("--scheduler", help="with --campaign: a Dask scheduler address (default: a LocalCluster of "
                                         "--workers processes, 2 if not given)")
     ap.add_argument("--motion", default="xva", help="with --make-datasets --model damper: which of the clamp's "
@@ -74,7 +76,8 @@ def run(args, ap) -> int:
                 print(path)
             return 0
         if args.campaign:
-            campaign.run(args.campaign, args.out, args.fmus, args.campaign_seed, args.workers or 2, args.scheduler)
+            campaign.run(args.campaign, args.out, args.fmus, args.campaign_seed, args.workers or 2, args.scheduler,
+                         calibrate=args.calibrate)
             print((pathlib.Path(args.out) / "summary.md").read_text())
             return 0
         cfg = load_config(args.config) if args.config else None

@@ -92,13 +92,17 @@ def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, po
     return np.concatenate(list(pool.map(one, range(len(records))) if pool else map(one, range(len(records)))))
 
 
+BASIN_SHARE = 1 / 3  # of a refit's budget, for the probe of each basin before the best goes on
+
+
 def run_fit(task: FitTask) -> Fit:
     """Least squares on the stacked calibration residuals within task.bounds, from the best of task.start and
     task.alternatives; with task.continuation in stages, each from the best point so far (by the residual of
     every record): the envelopes of non-periodic records (a third of the budget), the lowest level alone (a
     quarter), then every record. Never worse than the best start: each stage and the last least squares keep
     the best point they evaluated. With task.basin_key the same from the best start of each value of that
-    parameter (an SDOF loop, whose ν sets the scale of β, has a basin at each ν), the best result kept."""
+    parameter (an SDOF loop, whose ν sets the scale of β, has a basin at each ν), each with BASIN_SHARE of the
+    budget first, then the best of them with the whole budget."""
     t0 = time.perf_counter()
     threads = max(1, min(task.threads, len(task.records)))
     runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
@@ -142,20 +146,21 @@ def run_fit(task: FitTask) -> Fit:
         n += result.n_evaluations
         return (result.x, result.error, n) if result.error <= e0 else (x0, e0, n)
 
-    # from the best start; with task.basin_key, from the best start of each of its values, each with the
-    # whole budget
+    # from the best start; with task.basin_key, from the best start of each of its values, each descended with
+    # a share of the budget (BASIN_SHARE), then the best of them on with the whole budget
     order = np.argsort(errors)
+    best_x, error = candidates[order[0]], errors[order[0]]
     if task.basin_key:
         firsts = {}
         for k in order:
             firsts.setdefault(round(unit.values(candidates[k])[task.basin_key], 6), k)
-        order = sorted(firsts.values(), key=lambda k: errors[k])
-    best_x, error = None, np.inf
-    for k in order[:len(order) if task.basin_key else 1]:
-        x, e, n = descend(candidates[k], errors[k], task.budget)
-        used += n
-        if e < error:
-            best_x, error = x, e
+        for k in firsts.values():
+            x, e, n = descend(candidates[k], errors[k], max(1, int(task.budget * BASIN_SHARE)))
+            used += n
+            if e < error:
+                best_x, error = x, e
+    best_x, error, n = descend(best_x, error, task.budget)
+    used += n
     best = params(best_x)
     if task.floor is not None:  # never worse than the nominal model (the effect at zero)
         floor = with_derived({**task.fixed, **task.floor}, task.derived)

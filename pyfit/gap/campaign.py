@@ -10,7 +10,8 @@ held-out misfit over the noise floor, both from the report.
 
 The summary holds the confusion matrix (withheld × named), top-1 accuracy by effect-to-noise ratio (the
 detection limit), the false-alarm rate on the null cases, and the hit rate by the report's margin (the
-best candidate's held-out shrink), the figure a single report's confidence is read against.
+best candidate's held-out shrink): the calibration a single report's confidence is read from
+(pyfit.gap.confidence), and the check of the confidence the reports stated against what happened.
 """
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from pyfit.gap import datasets
+from pyfit.gap import confidence, datasets
 from pyfit.gap.diagnose import DiagnoseConfig, diagnose
 from pyfit.runtime.batch import map_tasks
 
@@ -29,7 +30,6 @@ EFFECTS = ("hysteresis", "cubic_stiffness", "coulomb_friction", "quadratic_dampi
 STRENGTH_RANGE = (0.05, 2.0)  # factor on the family's reference strength, drawn log-uniformly
 SHARES = {"none": 0.2, "single": 0.6, "pair": 0.2}  # how often a case withholds nothing, one effect, two
 ENR_BINS = (0.0, 2.0, 5.0, 10.0, 20.0, np.inf)  # effect-to-noise ratio bins of the detection-limit table
-SHRINK_BINS = (-np.inf, 50.0, 80.0, 95.0, np.inf)  # best candidate's held-out shrink [%]: the confidence table
 
 
 @dataclass(frozen=True)
@@ -111,19 +111,28 @@ def run_case(job: CaseJob) -> dict:
         named, gap = rep["chosen_effect"], rep["gap"]
         top = rep["ranking"][0]["shrink_pct"] if rep["ranking"] else None
         outcome = {"named": "+".join(sorted((named or "").split(" + "))) or "none", "verdict": rep["verdict"],
-                   "enr": gap["overall"] / gap["noise_floor"], "top_shrink_pct": top}
+                   "enr": gap["overall"] / gap["noise_floor"], "top_shrink_pct": top,
+                   "stated": rep["confidence"]["rate"] if rep["confidence"] else None}
     except Exception as exc:  # a case that breaks the diagnosis is an outcome of the campaign, not its end
-        outcome = {"named": "error", "verdict": f"{type(exc).__name__}: {exc}", "enr": None, "top_shrink_pct": None}
+        outcome = {"named": "error", "verdict": f"{type(exc).__name__}: {exc}", "enr": None, "top_shrink_pct": None,
+                   "stated": None}
     outcome.update({"case": asdict(c), "withheld": c.withheld, "data_s": written,
                     "diagnose_s": time.perf_counter() - t0 - written})
     done.write_text(json.dumps(outcome, indent=1, default=float))
     return outcome
 
 
+def command(n: int, seed: int) -> str:
+    """The command line that runs this campaign."""
+    return f"stockbridge diagnose --campaign {n} --campaign-seed {seed}"
+
+
 def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=None, sweep_s: float = 15.0,
-        progress: bool = True) -> dict:
+        progress: bool = True, calibrate: bool = False) -> dict:
     """Draw n cases and diagnose them: on `scheduler` (a Dask scheduler address) when given, else on a Dask
-    LocalCluster of `workers` single-threaded processes. Writes OUT/summary.md and OUT/summary.json."""
+    LocalCluster of `workers` single-threaded processes. Writes OUT/summary.md and OUT/summary.json; with
+    `calibrate`, its hit rates become the package's confidence calibration (pyfit.gap.confidence)."""
+    stated_from = confidence.load()
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     jobs = [CaseJob(c, str(out), str(fmu_dir), sweep_s) for c in draw(n, seed)]
@@ -140,18 +149,18 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
         where = f"Dask scheduler {scheduler}"
     summary = summarise(outcomes)
     summary.update({"cases": n, "seed": seed, "sweep_s": sweep_s, "wall_s": time.perf_counter() - t0,
-                    "where": where})
+                    "where": where, "command": command(n, seed),
+                    "stated_from": {k: stated_from[k] for k in ("source", "seed", "cases")} if stated_from else None})
+    if calibrate:
+        confidence.write(confidence.calibration_of(outcomes, command(n, seed), seed))
     (out / "summary.json").write_text(json.dumps({**summary, "outcomes": outcomes}, indent=1, default=float))
     (out / "summary.md").write_text(markdown(summary))
     return summary
 
 
-def _bin(value, edges) -> int | None:
-    return None if value is None else int(np.searchsorted(edges, value, side="right") - 1)
-
-
 def summarise(outcomes: list[dict]) -> dict:
-    """Confusion matrix, top-1 accuracy by effect-to-noise ratio, false alarms on nulls, hit rate by margin."""
+    """Confusion matrix, top-1 accuracy by effect-to-noise ratio, false alarms on nulls, hit rate by margin (the
+    calibration), stated confidence against the hit rate."""
     labels = sorted({o["withheld"] for o in outcomes} | {o["named"] for o in outcomes})
     confusion = {w: {n: sum(o["withheld"] == w and o["named"] == n for o in outcomes) for n in labels}
                  for w in labels}
@@ -159,25 +168,17 @@ def summarise(outcomes: list[dict]) -> dict:
     nulls = [o for o in outcomes if o["withheld"] == "none"]
     by_enr = []
     for k in range(len(ENR_BINS) - 1):
-        inside = [o for o in effects if _bin(o["enr"], ENR_BINS) == k]
+        inside = [o for o in effects if confidence.bin_of(o["enr"], ENR_BINS) == k]
         by_enr.append({"enr": [ENR_BINS[k], ENR_BINS[k + 1]], "cases": len(inside),
                        "hits": sum(o["named"] == o["withheld"] for o in inside)})
-    named = [o for o in outcomes if o["named"] not in ("none", "error")]
-    by_shrink = []
-    for k in range(len(SHRINK_BINS) - 1):
-        inside = [o for o in named if _bin(o["top_shrink_pct"], SHRINK_BINS) == k]
-        by_shrink.append({"shrink_pct": [SHRINK_BINS[k], SHRINK_BINS[k + 1]], "named": len(inside),
-                          "right": sum(o["named"] == o["withheld"] for o in inside)})
+    calibration = confidence.calibration_of(outcomes, "", 0)
     return {"labels": labels, "confusion": confusion,
             "top1": sum(o["named"] == o["withheld"] for o in effects) / max(len(effects), 1),
             "effect_cases": len(effects), "null_cases": len(nulls),
-            "false_alarms": sum(o["named"] != "none" for o in nulls), "by_enr": by_enr, "by_shrink": by_shrink,
+            "false_alarms": sum(o["named"] != "none" for o in nulls), "by_enr": by_enr,
+            "by_shrink": calibration["by_shrink"], "no_gap": calibration["no_gap"], "check": confidence.check(outcomes),
             "errors": sum(o["named"] == "error" for o in outcomes),
             "median_case_s": float(np.median([o["data_s"] + o["diagnose_s"] for o in outcomes]))}
-
-
-def _range(lo, hi) -> str:
-    return f"≥ {lo:g}" if hi == np.inf else f"< {hi:g}" if lo in (0.0, -np.inf) else f"{lo:g}–{hi:g}"
 
 
 def _share(part: int, whole: int) -> str:
@@ -188,7 +189,7 @@ def markdown(s: dict) -> str:
     """The campaign summary as Markdown."""
     lines = [f"{s['cases']} SDOF cases (seed {s['seed']}, sweeps {s['sweep_s']:g} s), {s['where']}: wall "
              f"{s['wall_s'] / 60:.1f} min, median {s['median_case_s']:.0f} s per case (writing the files and "
-             f"diagnosing); command: `stockbridge diagnose --campaign {s['cases']} --campaign-seed {s['seed']}`.", "",
+             f"diagnosing); command: `{s['command']}`.", "",
              f"Top-1 accuracy on the {s['effect_cases']} cases with a withheld effect: {100 * s['top1']:.0f} %; "
              f"false alarms on the {s['null_cases']} null cases: {s['false_alarms']}; diagnoses that failed: "
              f"{s['errors']}.", "", "**Confusion matrix** (rows: withheld; columns: named)", "",
@@ -198,9 +199,22 @@ def markdown(s: dict) -> str:
             lines.append(f"| {w} | " + " | ".join(str(s["confusion"][w][n] or "·") for n in s["labels"]) + " |")
     lines += ["", "**Detection limit**: top-1 accuracy by effect-to-noise ratio (nominal held-out misfit over "
               "the noise floor)", "", "| effect-to-noise ratio | cases | named right |", "|---|---|---|"]
-    lines += [f"| {_range(*b['enr'])} | {b['cases']} | {_share(b['hits'], b['cases'])} |" for b in s["by_enr"]]
-    lines += ["", "**Confidence**: when the report names an effect, how often it is right, by the named model's "
-              "held-out shrink", "", "| held-out shrink [%] | named | right |", "|---|---|---|"]
-    lines += [f"| {_range(*b['shrink_pct'])} | {b['named']} | {_share(b['right'], b['named'])} |"
+    lines += [f"| {confidence.range_label(*b['enr'])} | {b['cases']} | {_share(b['hits'], b['cases'])} |"
+              for b in s["by_enr"]]
+    q = s["no_gap"]
+    lines += ["", "**Calibration**: when a report names an effect, how often it is right, by the named model's "
+              "held-out shrink (a single report states the rate of its row as its confidence)", "",
+              "| held-out shrink [%] | named | right |", "|---|---|---|"]
+    lines += [f"| {confidence.range_label(*b['shrink_pct'])} | {b['named']} | {_share(b['right'], b['named'])} |"
               for b in s["by_shrink"]]
+    lines += [f"| verdict 'no significant gap' | {q['verdicts']} | {_share(q['right'], q['verdicts'])} |"]
+    src = s.get("stated_from")
+    if src:
+        inside = " (the same cases: in-sample, not a check)" if src["seed"] == s["seed"] else ""
+        lines += ["", f"**Stated confidence against the hit rate**: the reports stated the confidence of the "
+                  f"calibration of `{src['source']}` ({src['cases']} cases){inside}", "",
+                  "| stated confidence | reports | mean stated | right |", "|---|---|---|---|"]
+        lines += [f"| {c['stated_pct']} % | {c['reports']} | "
+                  f"{'—' if c['mean_stated'] is None else format(100 * c['mean_stated'], '.0f') + ' %'} | "
+                  f"{_share(c['right'], c['reports'])} |" for c in s["check"]]
     return "\n".join(lines) + "\n"

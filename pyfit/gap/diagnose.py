@@ -8,6 +8,7 @@ import json
 import os
 import pathlib
 import dataclasses
+import functools
 from dataclasses import asdict, dataclass, fields
 
 
@@ -18,7 +19,7 @@ from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
 from pyfit.runtime.examples import ensure_fmu
 from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read_toml
-from pyfit.gap import localise, selection, user_candidates
+from pyfit.gap import confidence, localise, selection, user_candidates
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import Fit, effect_task, nominal_task, run_fit, screen
 from pyfit.gap.systems import combine, family_fmu, make_system
@@ -48,7 +49,8 @@ class DiagnoseConfig:
     explain_margin: float = 0.02  # ... or within the floor + explain_margin (the absolute criterion)
     nominal_max_nrmse: float = 0.8  # a nominal whose NRMSE on its best calibration file exceeds this "does not fit"
     max_effects: int = 2  # effects combined at most (forward selection, while the misfit is above the noise)
-    partners: int = 3  # candidates tried as the next member of a combination (by the screening at that model)
+    partners: int = 4  # candidates tried as the next member of a combination (by the screening at that model)
+    beam: int = 2  # single effects the forward selection starts from (the best-scoring ones)
     min_excess_cut: float = 0.5  # share of the misfit above the noise floor a larger combination must remove
 
 
@@ -147,66 +149,91 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
 
 def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, scale, fits: dict, sims: dict, gap,
                   runner, out: pathlib.Path, key: str, workers, progress):
-    """Forward selection while the best model's held-out misfit stays above the noise (`noise_factor` x the
-    floor): extend it by each of the `cfg.partners` other effects whose sensitivity at that model explains most
-    of its calibration residual (the screening repeated there), refit jointly (from each
-    member's own refit and the effects' starts), and keep the best combination when it removes `min_excess_cut`
-    of the misfit above the floor that the model it extends leaves once refitted with the same budget, up to
-    `cfg.max_effects` members. Adds the fits and held-out simulations to `fits` and `sims`; returns the system
-    with the combined effects among its effects and the model selected (None when nothing was tried)."""
+    """Forward selection while a model's held-out misfit stays above the noise (`noise_factor` x the floor),
+    from each of the `cfg.beam` best single effects (by score; a flexible stand-in can lead, the true first
+    member come second): extend the model by each of the `cfg.partners` other effects whose sensitivity at that
+    model explains most of its calibration residual (the screening repeated there), refit jointly (from each
+    member's own refit and the effects' starts), and go on from the best combination when it removes
+    `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted with the same
+    budget, up to `cfg.max_effects` members. Of the ends of these paths, a larger model is selected only by the
+    same rule (selection.simpler_or_better). Adds the fits and held-out simulations to `fits` and `sims`; returns the
+    system with the combined effects among its effects and the model selected (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
     at_noise = cfg.noise_factor * floor
     after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
-    current = max(fits, key=lambda n: selection.score(before, after[n], floor, fits[n].n_added), default=None)
-    if current is None or after[current] <= at_noise:
+
+    def score(name):
+        return selection.score(before, after[name], floor, fits[name].n_added)
+
+    ranked = sorted(fits, key=lambda n: -score(n))
+    if not ranked or after[ranked[0]] <= at_noise:
         return system, None
     effects = dict(system.effects)
+    named = {frozenset([n]): n for n in fits}  # members -> the name their model is stored under
 
     def simulated(name):
         sims[name] = {r.name: sim.simulate(runner, r, fits[name].params, cfg.upsample, system.lead_periods)
                       for r in held}
         after[name] = selection.heldout_nrmse(sims[name], held)
 
-    while len(effects[current].members or (current,)) < cfg.max_effects and after[current] > at_noise:
-        members = list(effects[current].members or (current,))
-        # the model so far, refitted on from its own result with a combination's budget: a combination must
-        # beat more evaluations of its first member(s), not only the first refit
-        again_path = out / "fits" / f"{current.replace(' + ', '+')}.continued.json"
-        again = _stored(again_path, key)
-        jobs = [] if again else [(effect_task(system, effects[current], fmu, cal, nominal, scale, cfg.refit_budget,
-                                              cfg.upsample, seeds=(fits[current].params,)), str(again_path), key)]
-        names = []
-        # the next member: the candidates whose sensitivity at the model so far explains most of its residual
-        # on the calibration files (the screening's score test, repeated at that model)
-        others = [n for n in system.effects if n not in members and n in fits]
-        explained, _ = screen(system, fmu, cal, fits[current], scale, cfg.upsample, others)
-        for partner in sorted(others, key=lambda n: -explained[n])[:cfg.partners]:
-            combo = combine([system.effects[m] for m in members + [partner]])
-            effects[combo.name] = combo
-            path = out / "fits" / f"{combo.name.replace(' + ', '+')}.json"
-            fits[combo.name] = _stored(path, key)
-            names.append(combo.name)
-            if fits[combo.name] is None:
-                seeds = (fits[current].params, {**fits[current].params, **{
-                    p.name: fits[partner].params[p.name] for p in system.effects[partner].params}})
-                jobs.append((effect_task(system, combo, fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
-                                         seeds=seeds), str(path), key))
-        for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="combinations"):
-            if fit.effect == current:
-                again = fit
-            else:
-                fits[fit.effect] = fit
-        if again.calibration_nrmse < fits[current].calibration_nrmse:
-            fits[current] = again
-            simulated(current)
-        for name in names:
-            simulated(name)
-        best = min(names, key=lambda n: after[n], default=None)
-        excess = after[current] - floor
-        if best is None or after[current] <= at_noise or after[best] - floor > (1.0 - cfg.min_excess_cut) * excess:
-            break  # (the model so far, refitted on, may itself reach the noise: nothing left to add)
-        current = best
-    return dataclasses.replace(system, effects=effects), current
+    def grow(current):
+        while len(effects[current].members or (current,)) < cfg.max_effects and after[current] > at_noise:
+            members = list(effects[current].members or (current,))
+            # the model so far, refitted on from its own result with a combination's budget: a combination must
+            # beat more evaluations of its first member(s), not only the first refit
+            again_path = out / "fits" / f"{current.replace(' + ', '+')}.continued.json"
+            again = _stored(again_path, key)
+            jobs = [] if again else [(effect_task(system, effects[current], fmu, cal, nominal, scale,
+                                                  cfg.refit_budget, cfg.upsample, seeds=(fits[current].params,)),
+                                      str(again_path), key)]
+            names = []
+            # the next member: the candidates whose sensitivity at the model so far explains most of its
+            # residual on the calibration files (the screening's score test, repeated at that model)
+            others = [n for n in system.effects if n not in members and n in fits]
+            explained, _ = screen(system, fmu, cal, fits[current], scale, cfg.upsample, others)
+            for partner in sorted(others, key=lambda n: -explained[n])[:cfg.partners]:
+                together = frozenset(members + [partner])
+                if together in named:  # reached from another single effect
+                    names.append(named[together])
+                    continue
+                combo = combine([system.effects[m] for m in members + [partner]])
+                effects[combo.name], named[together] = combo, combo.name
+                path = out / "fits" / f"{combo.name.replace(' + ', '+')}.json"
+                fits[combo.name] = _stored(path, key)
+                names.append(combo.name)
+                if fits[combo.name] is None:
+                    seeds = (fits[current].params, {**fits[current].params, **{
+                        p.name: fits[partner].params[p.name] for p in system.effects[partner].params}})
+                    jobs.append((effect_task(system, combo, fmu, cal, nominal, scale, cfg.refit_budget,
+                                             cfg.upsample, seeds=seeds), str(path), key))
+            for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="combinations"):
+                if fit.effect == current:
+                    again = fit
+                else:
+                    fits[fit.effect] = fit
+            if again.calibration_nrmse < fits[current].calibration_nrmse:
+                fits[current] = again
+                simulated(current)
+            for name in names:
+                if name not in after or name not in sims:
+                    simulated(name)
+            best = min(names, key=lambda n: after[n], default=None)
+            if best is None or after[current] <= at_noise or \
+                    not selection.adds_enough(after[current], after[best], floor, cfg.min_excess_cut):
+                break  # (the model so far, refitted on, may itself reach the noise: nothing left to add)
+            current = best
+        return current
+
+    def kept(a, b):  # of two path ends, the one a path would keep (selection.simpler_or_better)
+        sized = [(len(effects[n].members or (n,)), after[n]) for n in (a, b)]
+        return (a, b)[selection.simpler_or_better(*sized, floor, cfg.min_excess_cut)]
+
+    ends = []
+    for start in ranked[:cfg.beam]:
+        ends.append(grow(start))
+        if after[ends[-1]] <= at_noise:
+            break  # a path that reaches the noise: no other start can do better than the noise
+    return dataclasses.replace(system, effects=effects), functools.reduce(kept, ends)
 
 
 def fmu_defaults(runner: FmuRunner) -> dict[str, float]:
@@ -266,8 +293,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)
     judging = ("min_gap", "noise_factor", "close_points", "min_shrink_pct", "explain_factor", "explain_margin",
-               "nominal_max_nrmse", "max_effects", "partners", "min_excess_cut")  # how results are judged and which
-    # combinations are tried, not how a fit is made: stored fits stay valid
+               "nominal_max_nrmse", "max_effects", "partners", "min_excess_cut", "beam")
+    # (how results are judged and which combinations are tried, not how a fit is made: stored fits stay valid)
     settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in judging}, sort_keys=True)
     description = json.dumps({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}
                              if described else {}, sort_keys=True)
@@ -330,6 +357,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
                              selected)
     result["level_order"] = level_order
+    top = result["ranking"][0]["shrink_pct"] if result["ranking"] else None
+    result["confidence"] = confidence.stated(result["verdict"], result["chosen_effect"], top, confidence.load())
     result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample, system.lead_periods)
     runner.close()
     clock.end("verdict")

@@ -8,7 +8,7 @@ import pathlib
 import numpy as np
 
 from pyfit.report import plots
-from pyfit.gap import localise, selection
+from pyfit.gap import confidence, localise, selection
 from pyfit.gap import simulate as sim
 
 
@@ -302,16 +302,19 @@ def markdown(result: dict) -> str:
     """The report as markdown (tables, evidence, figures)."""
     g = result["gap"]
     lines = [f"# Gap diagnosis: {result['model']} ({result['fmu']})", "",
-             f"**Verdict: {result['verdict']}.**", "",
-             f"Calibrated on {', '.join(result['calibration_files'])}; held out: "
-             f"{', '.join(result['held_out_files'])}. Levels ordered by {result['level_order']}.",
-             "",
-             f"Held-out gap (NRMSE) of the nominal model: **{g['overall']:.4f}**; noise floor from the data: "
-             f"{g['noise_floor']:.4f} ({', '.join(g.get('noise_floor_method', []))}); nominal calibration NRMSE "
-             f"{result['nominal']['calibration_nrmse']:.4f}. An effect explains the gap when the held-out NRMSE with "
-             f"it is at most {result['explained_below']:.4f}.", "", "## Which effect", "",
-             "| effect | score | held-out gap after | shrink [%] | screening [%] | strength params | fitted |",
-             "|---|---|---|---|---|---|---|"]
+             f"**Verdict: {result['verdict']}.**", ""]
+    if result.get("confidence"):
+        lines += [confidence.Confidence(**result["confidence"]).sentence(), ""]
+    lines += [
+        f"Calibrated on {', '.join(result['calibration_files'])}; held out: "
+        f"{', '.join(result['held_out_files'])}. Levels ordered by {result['level_order']}.",
+        "",
+        f"Held-out gap (NRMSE) of the nominal model: **{g['overall']:.4f}**; noise floor from the data: "
+        f"{g['noise_floor']:.4f} ({', '.join(g.get('noise_floor_method', []))}); nominal calibration NRMSE "
+        f"{result['nominal']['calibration_nrmse']:.4f}. An effect explains the gap when the held-out NRMSE with "
+        f"it is at most {result['explained_below']:.4f}.", "", "## Which effect", "",
+        "| effect | score | held-out gap after | shrink [%] | screening [%] | strength params | fitted |",
+        "|---|---|---|---|---|---|---|"]
     for r in result["ranking"]:
         params = ", ".join(f"{k} = {v:.4g}" for k, v in r["params"].items())
         lines.append(f"| {r['effect']} | {r['score']:.1f} | {r['heldout_gap_after']:.4f} | {r['shrink_pct']:.1f} | "

@@ -23,3 +23,19 @@ def shrink_pct(before: float, after: float, reference: float) -> float:
 def score(before: float, after: float, reference: float, strengths: int) -> float:
     """Shrink [%] less PENALTY_POINTS per strength parameter beyond the first: what a candidate pays for."""
     return shrink_pct(before, after, reference) - PENALTY_POINTS * (strengths - 1)
+
+
+def adds_enough(smaller_after: float, larger_after: float, floor: float, min_excess_cut: float) -> bool:
+    """Whether a model with more effects earns them: it removes at least `min_excess_cut` of the held-out misfit
+    above the noise floor that the smaller model leaves."""
+    return larger_after - floor <= (1.0 - min_excess_cut) * (smaller_after - floor)
+
+
+def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, min_excess_cut: float) -> int:
+    """Of two models given as (number of effects, held-out NRMSE), the index (0: a, 1: b) of the one kept: of
+    two as large, the lower misfit; else the larger only when it adds enough (adds_enough)."""
+    if a[0] == b[0]:
+        return 0 if a[1] <= b[1] else 1
+    small, large = (0, 1) if a[0] < b[0] else (1, 0)
+    pair = (a, b)
+    return large if adds_enough(pair[small][1], pair[large][1], floor, min_excess_cut) else small

@@ -48,6 +48,8 @@ class SyntheticSpec:
     anti_alias: bool = True  # zero-phase FIR before decimation; False = plain sampling
     passband_ripple_db: float | None = None  # None: scipy's decimate FIR (Hamming, 20*q taps: +0.024 dB
     # at 58 Hz of a 1 kHz sensor); a value: a Kaiser FIR designed for this ripple (a DAQ-grade chain)
+    rtol: float = 1e-10  # CVODES relative and absolute tolerances (SI units of the states)
+    atol: float = 1e-14
 
 
 def anti_alias_fir(oversample: int, ripple_db: float) -> np.ndarray:
@@ -79,7 +81,7 @@ def simulate_truth(spec: SyntheticSpec) -> tuple[np.ndarray, dict[str, np.ndarra
         t = t_fine[::spec.oversample]
     if spec.solver == "cvodes":
         truth = integrate.simulate_cvodes(ref, t_fine, params=spec.params, excitation=excitation, inputs=sampled,
-                                          rtol=1e-10, atol=1e-14)
+                                          rtol=spec.rtol, atol=spec.atol)
     else:
         truth = integrate.simulate_newmark(ref, t_fine, params=spec.params, excitation=excitation, inputs=sampled)
     rng = np.random.default_rng(spec.seed)

@@ -1,0 +1,29 @@
+"""The rules that pick among candidate models on the held-out files (pyfit.gap.selection): the shrink, the score,
+and when a model with more effects earns them, with the misfits of a campaign case (a hardening spring with
+quadratic damping withheld, floor 0.0021: a single hysteresis loop 0.0207, the true pair 0.0054)."""
+import pytest
+
+from pyfit.gap import selection
+
+
+def test_shrink_and_score():
+    assert selection.shrink_pct(0.31, 0.0207, 0.0021) == pytest.approx(100 * (0.31 - 0.0207) / (0.31 - 0.0021))
+    assert selection.shrink_pct(0.001, 0.0005, 0.002) == 0.0  # no gap above the reference: nothing to shrink
+    # a pair pays 5 points for its second strength parameter: here the single loop scores a hair higher
+    single = selection.score(0.3129, 0.0207, 0.0021, 1)
+    pair = selection.score(0.3129, 0.0054, 0.0021, 2)
+    assert single > pair and single - pair < 1.0
+
+
+def test_a_larger_model_is_kept_only_when_it_removes_half_the_misfit_left_above_the_floor():
+    floor, cut = 0.0021, 0.5
+    # the pair leaves 0.0033 above the floor, the single loop 0.0186: the pair is kept, in either order
+    assert selection.adds_enough(0.0207, 0.0054, floor, cut)
+    assert selection.simpler_or_better((1, 0.0207), (2, 0.0054), floor, cut) == 1
+    assert selection.simpler_or_better((2, 0.0054), (1, 0.0207), floor, cut) == 0
+    # a pair that removes less than half of it is not: the simpler model stays
+    assert not selection.adds_enough(0.0207, 0.0120, floor, cut)
+    assert selection.simpler_or_better((1, 0.0207), (2, 0.0120), floor, cut) == 0
+    # exactly half is enough; of two as large, the lower misfit
+    assert selection.adds_enough(0.0207, floor + 0.5 * (0.0207 - floor), floor, cut)
+    assert selection.simpler_or_better((2, 0.0060), (2, 0.0054), floor, cut) == 1
