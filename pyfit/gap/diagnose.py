@@ -156,8 +156,9 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     member's own refit and the effects' starts), and go on from the best combination when it removes
     `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted with the same
     budget, up to `cfg.max_effects` members. Of the ends of these paths, a larger model is selected only by the
-    same rule (selection.simpler_or_better). Adds the fits and held-out simulations to `fits` and `sims`; returns the
-    system with the combined effects among its effects and the model selected (None when nothing was tried)."""
+    same rule (selection.simpler_or_better). Adds the fits and held-out simulations to `fits` and `sims`;
+    returns the system with the combined effects among its effects and the model selected (None when nothing
+    was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
     at_noise = cfg.noise_factor * floor
     after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
