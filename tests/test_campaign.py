@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pyfit.gap import campaign
-from pyfit.gap.systems import SDOF_EFFECTS, Scale
+from pyfit.gap.systems import DAMPER_LOOP_STARTS, SDOF_EFFECTS, Scale
 
 
 def test_the_draw_is_reproducible_and_spans_nulls_singles_and_pairs():
@@ -15,8 +15,35 @@ def test_the_draw_is_reproducible_and_spans_nulls_singles_and_pairs():
     kinds = [0 if c.withheld == "none" else len(c.withheld.split("+")) for c in a]
     # shares 0.2 / 0.6 / 0.2: binomial standard deviation of a count of 200 is at most 7
     assert abs(kinds.count(0) - 40) < 4 * 7 and abs(kinds.count(1) - 120) < 4 * 7 and abs(kinds.count(2) - 40) < 4 * 7
-    assert {c.excitation for c in a} == {"multisine", "sweep"} and {c.output for c in a} == {"y", "a"}
+    assert {c.excitation for c in a} == {"multisine", "sweep", "stepped_sine", "noise"}
+    assert {c.outputs for c in a} == {("y",), ("a",)}
     assert {c.truth["nu"] for c in a if "nu" in c.truth} == {1.0, 2.0, 3.0}
+
+
+def test_drawn_dampers_span_the_catalogue_and_their_band_holds_two_resonances():
+    """Damper cases: geometry within the catalogue ranges, the test band around the two lowest resonances of the
+    reference model, every sensor set and clamp motion, no stepped sine (a clamp displacement cannot step), loop
+    shapes away from the candidate's starts."""
+    from pyfit.reference.models import damper_modes_hz
+
+    cases = campaign.draw(60, seed=5, model="damper")
+    assert cases == campaign.draw(60, seed=5, model="damper") and {c.model for c in cases} == {"damper"}
+    for c in cases:
+        g = c.base
+        assert all(0.5 <= g[f"m{i}"] <= 4.0 and 0.1 <= g[f"L{i}"] <= 0.3 and 0.0 <= g[f"a{i}"] <= 0.05 for i in (1, 2))
+        f = damper_modes_hz(g)
+        assert c.band_hz[0] < f[0] < f[1] < c.band_hz[1] and 4.0 <= f[0] and f[1] <= 60.0
+    assert {c.outputs for c in cases} == set(campaign.DAMPER_OUTPUTS)
+    assert {c.motion for c in cases} == set(campaign.DAMPER_MOTIONS)
+    assert {c.excitation for c in cases} == set(campaign.DAMPER_EXCITATIONS)
+    starts = DAMPER_LOOP_STARTS  # the candidate's default start and its other shape starts
+    loops = [c.truth for c in cases if "a_bw" in c.truth]
+    assert loops and all(all(abs(lp["a_bw"] - s["a_bw"]) > 1e-6 for s in starts) for lp in loops)
+
+
+def test_calibrating_on_damper_cases_is_refused(tmp_path):
+    with pytest.raises(ValueError, match="calibration is of sdof cases"):
+        campaign.run(2, tmp_path, calibrate=True, model="damper")
 
 
 def test_no_drawn_loop_sits_at_a_start_of_the_candidate():
@@ -50,7 +77,7 @@ def test_the_summary_counts_what_was_named_against_what_was_withheld():
 def test_a_short_campaign_on_a_local_dask_cluster(tmp_path, fmu_dir, measured):
     summary = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)
     measured("short campaign (20 random SDOF cases): top-1 accuracy on cases with a withheld effect",
-             summary["top1"], 0.7, at_least=True)  # measured 0.87 on seed 0 (docs/validation.md): a guard
+             summary["top1"], 0.7, at_least=True)  # a guard below the 200-case campaign's (docs/validation.md)
     measured("short campaign: false alarms on the null cases", summary["false_alarms"], 0)
     assert summary["errors"] == 0
     again = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)  # resumes: nothing redone

@@ -61,6 +61,11 @@ def test_sdof_coulomb_friction_and_cubic_stiffness_are_named_together(tmp_path, 
     measured("SDOF with Coulomb friction and cubic stiffness withheld: held-out shrink of the pair [%]",
              best["shrink_pct"], 90.0, at_least=True)
     measured("the same: fitted k3 relative to the withheld value", abs(best["params"]["k3"] / truth["k3"] - 1), 0.05)
+    # a combination is refitted from the model it extends and never ends worse than it on the calibration files
+    calibration = {r["effect"]: r["calibration_nrmse"] for r in rep["ranking"]}
+    for r in rep["ranking"]:
+        if len(r["members"]) > 1:
+            assert r["calibration_nrmse"] <= max(calibration[m] for m in r["members"]) * (1 + 1e-12), r["effect"]
 
 
 def test_the_thesis_damper_with_hysteresis_and_softening_springs_is_named_as_both(tmp_path, fmu_dir, measured):

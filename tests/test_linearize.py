@@ -25,3 +25,19 @@ def test_damper_modes_match_independently_assembled_matrices(fmu_dir, measured):
              "M, C, K, max relative error", worst, 1e-6)
     measured("the same: damping ratios, max relative error", max(abs(g.zeta / r.zeta - 1) for g, r in zip(got, ref)),
              1e-5)
+
+
+def test_reference_damper_modes_match_the_fmu_for_a_drawn_geometry(fmu_dir, measured):
+    """The campaign's damper geometry (pyfit.gap.campaign.damper_geometry) sets its test band from the CasADi
+    reference's modes (pyfit.reference.models.damper_modes_hz): they must be the FMU's, within the damping's
+    shift of an undamped frequency (ζ ≤ 5 %: f_n as |λ| is the undamped one exactly for proportional damping)."""
+    from pyfit.gap.campaign import damper_geometry
+    from pyfit.reference.models import damper_modes_hz
+
+    geometry, band = damper_geometry(np.random.default_rng(11))
+    linear = {"exc_type": 0, "k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, **geometry}
+    got = [m.f_n for m in linear_modes(fmu_dir / "StockbridgeDamper.fmu", linear)]
+    ref = damper_modes_hz(geometry)
+    measured("campaign damper (random geometry): reference undamped frequencies vs the FMU linearised at rest, "
+             "max relative error", max(abs(g / r - 1) for g, r in zip(got, ref)), 1e-6)
+    assert band[0] < got[0] < got[1] < band[1]

@@ -27,3 +27,13 @@ def test_a_larger_model_is_kept_only_when_it_removes_half_the_misfit_left_above_
     # exactly half is enough; of two as large, the lower misfit
     assert selection.adds_enough(0.0207, floor + 0.5 * (0.0207 - floor), floor, cut)
     assert selection.simpler_or_better((2, 0.0060), (2, 0.0054), floor, cut) == 1
+
+
+def test_a_model_is_extended_only_while_its_misfit_is_a_significant_gap():
+    """The forward selection goes on by the nominal's test (noise_factor 1.2, min_gap 0.005): a single effect that
+    leaves 2.5x a floor of 0.0019 (less than min_gap above it) is not extended; one that leaves 2.9x a floor of
+    0.005 (0.0094 above it) is; a misfit 0.008 above a floor of 0.05 is within 1.2x the floor (campaign cases)."""
+    assert not selection.significant(0.0047, 0.0019, 1.2, 0.005)
+    assert selection.significant(0.0144, 0.005, 1.2, 0.005)
+    assert not selection.significant(0.058, 0.05, 1.2, 0.005)
+    assert selection.significant(0.0611, 0.05, 1.2, 0.005)

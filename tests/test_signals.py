@@ -1,6 +1,7 @@
 """Analysis functions against analytic results, and steady-state energy checks on the FMUs."""
 import numpy as np
 import pytest
+import scipy.signal
 
 from pyfit.analysis import signals
 from pyfit.analysis.excitation import multisine
@@ -134,3 +135,55 @@ def test_envelope_of_a_modulated_sweep_is_its_amplitude(measured):
     rec = Record("r", "", 1.0, fs, {"u": t}, {"y": y}, 0)
     assert np.all(envelope_residuals({"y": y}, rec) == 0.0)
     assert np.sum(envelope_residuals(None, rec) ** 2) == pytest.approx(100.0)  # the penalty: NRMSE 10
+
+
+def _on_casadi(signal, t):
+    """The signal evaluated through a CasADi expression (as the reference integrator sees it)."""
+    import casadi as ca
+
+    ts = ca.SX.sym("t")
+    return np.array(ca.Function("s", [ts], [signal(ts)]).map(len(t))(t[None, :])).ravel()
+
+
+def test_a_stepped_sine_dwells_at_each_frequency_with_a_continuous_phase(measured):
+    """SteppedSine: in every dwell (after the ramp) the zero-crossing rate is the step's frequency; the signal
+    never jumps more than a sine of the highest frequency can between samples; numpy and CasADi agree."""
+    from pyfit.analysis.excitation import SteppedSine
+
+    fs, freqs, dwell = 5000.0, tuple(np.geomspace(5.0, 80.0, 8)), 1.0
+    s = SteppedSine(freqs, dwell, amplitude=2.0)
+    t = np.arange(0.0, len(freqs) * dwell, 1 / fs)
+    x = s(t)
+    worst = 0.0
+    for j, f in enumerate(freqs):
+        inside = (t >= j * dwell + (s.t_ramp if j == 0 else 0.0)) & (t < (j + 1) * dwell)
+        seg, ts = x[inside], t[inside]
+        up = np.flatnonzero((seg[:-1] < 0) & (seg[1:] >= 0))
+        crossings = ts[up] - seg[up] * (ts[up + 1] - ts[up]) / (seg[up + 1] - seg[up])  # linear interpolation
+        worst = max(worst, abs((len(crossings) - 1) / (crossings[-1] - crossings[0]) / f - 1))
+    measured("stepped sine: zero-crossing frequency in each dwell vs the step's, max relative error", worst, 1e-3)
+    assert np.max(np.abs(np.diff(x))) <= 2.0 * 2 * np.pi * max(freqs) / fs
+    assert np.max(np.abs(_on_casadi(s, t[::50]) - x[::50])) < 1e-12
+    assert np.array_equal(s.frequency(np.array([0.5, 1.5, 99.0])), np.array(freqs)[[0, 1, -1]])
+
+
+def test_band_limited_noise_has_its_rms_its_band_and_a_gaussian_spread(measured):
+    """band_noise: the RMS after the ramp is the one asked for (within the scatter of a finite record of
+    incommensurate sines), 99 % of the power lies in the band (Welch, Hann), the kurtosis is a Gaussian's;
+    numpy and CasADi agree; another seed gives another signal."""
+    import scipy.stats
+
+    from pyfit.analysis.excitation import band_noise
+
+    fs, rms = 500.0, 3.0
+    n = band_noise(5.0, 80.0, rms, seed=7)
+    t = np.arange(0.0, 200.0, 1 / fs)
+    x = n(t)[int(n.t_ramp * fs):]
+    measured("band-limited noise: RMS over 199 s vs the RMS asked for, relative error",
+             abs(np.sqrt(np.mean(x**2)) / rms - 1), 0.03)
+    f, p = scipy.signal.welch(x, fs, nperseg=4096)
+    measured("band-limited noise: share of the power inside 5-80 Hz (Welch, Hann)",
+             p[(f >= 4.5) & (f <= 80.5)].sum() / p.sum(), 0.99, at_least=True)
+    measured("band-limited noise: |kurtosis - 3| (Gaussian: 0)", abs(scipy.stats.kurtosis(x, fisher=False) - 3), 0.2)
+    assert np.max(np.abs(_on_casadi(n, t[:2000:7]) - n(t[:2000:7]))) < 1e-9 * rms
+    assert not np.allclose(band_noise(5.0, 80.0, rms, seed=8)(t[:1000]), n(t[:1000]))

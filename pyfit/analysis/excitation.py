@@ -141,42 +141,100 @@ class MultisineInput:
                                  self.odd), self.periods)
 
 
-class PeriodicSignal:
-    """A band-limited periodic signal given by one period of samples, evaluated at any time t [s] as the
-    sum of its DFT lines (numpy arrays or CasADi expressions): the exact continuous-time input an
-    integrator with its own steps needs."""
+class SineSum:
+    """A sum of sines, mean + sum_i a_i cos(w_i t + p_i), optionally ramped in from rest (the C2 ramp of
+    `Excitation.envelope` over t_ramp [s]), evaluated at any time t [s] (numpy arrays or CasADi expressions):
+    the exact continuous-time input an integrator with its own steps needs."""
 
     kind = -1  # not a built-in FMU excitation
 
-    def __init__(self, period_samples: np.ndarray, fs: float):
-        n = len(period_samples)
-        spec = np.fft.rfft(period_samples) / n
-        lines = np.flatnonzero(np.abs(spec) > 1e-12 * np.abs(spec).max())
-        self.mean = float(spec[0].real)
-        lines = lines[lines > 0]
-        scale = np.where(2 * lines == n, 1.0, 2.0)
-        self.amplitudes = scale * np.abs(spec[lines])
-        self.omegas = 2 * np.pi * lines * fs / n
-        self.phases = np.angle(spec[lines])
+    def __init__(self, amplitudes, omegas, phases, mean: float = 0.0, t_ramp: float = 0.0):
+        self.amplitudes, self.omegas = np.asarray(amplitudes, float), np.asarray(omegas, float)
+        self.phases, self.mean, self.t_ramp = np.asarray(phases, float), float(mean), float(t_ramp)
 
     def derivative(self, t: np.ndarray, order: int) -> np.ndarray:
-        """The order-th time derivative at times t [s] (numpy), exact."""
+        """The order-th time derivative at times t [s] (numpy), exact; a ramped signal only after its ramp."""
+        if self.t_ramp > 0 and np.min(t) < self.t_ramp:
+            raise ValueError("derivative of a ramped sum of sines is given after the ramp only; use "
+                             "motion_with_derivatives")
         t = np.asarray(t, float)
         w = self.omegas[:, None]
         return np.sum(self.amplitudes[:, None] * w**order * np.cos(w * t.ravel() + self.phases[:, None]
                                                                   + order * np.pi / 2), axis=0).reshape(t.shape)
 
     def __call__(self, t):
+        ramp = Excitation(1, t_ramp=self.t_ramp).envelope(t)
         if _is_symbolic(t):
             import casadi as ca
 
-            out = self.mean
+            out = 0.0
             for a, w, p in zip(self.amplitudes, self.omegas, self.phases):
                 out = out + a * ca.cos(w * t + p)
-            return out
+            return self.mean + ramp * out
         t = np.asarray(t, float)
-        return self.mean + np.sum(self.amplitudes[:, None] * np.cos(np.outer(self.omegas, t.ravel())
-                                                                     + self.phases[:, None]), axis=0).reshape(t.shape)
+        waves = np.sum(self.amplitudes[:, None] * np.cos(np.outer(self.omegas, t.ravel()) + self.phases[:, None]),
+                       axis=0).reshape(t.shape)
+        return self.mean + ramp * waves
+
+
+class PeriodicSignal(SineSum):
+    """A band-limited periodic signal given by one period of samples at fs [Hz], as the sum of its DFT lines."""
+
+    def __init__(self, period_samples: np.ndarray, fs: float):
+        n = len(period_samples)
+        spec = np.fft.rfft(period_samples) / n
+        lines = np.flatnonzero(np.abs(spec) > 1e-12 * np.abs(spec).max())
+        lines = lines[lines > 0]
+        scale = np.where(2 * lines == n, 1.0, 2.0)
+        super().__init__(scale * np.abs(spec[lines]), 2 * np.pi * lines * fs / n, np.angle(spec[lines]),
+                         float(spec[0].real))
+
+
+def band_noise(f_min: float, f_max: float, rms: float, seed: int = 0, lines: int = 150,
+               t_ramp: float = 1.0) -> SineSum:
+    """Band-limited random noise on [f_min, f_max] Hz with the given RMS (after the ramp), as a shaker fed
+    by a noise generator gives it: `lines` sines at frequencies drawn uniformly in the band (not on a common
+    grid, so the signal never repeats), Rayleigh amplitudes and uniform phases: a Gaussian process with a flat
+    spectrum by the central limit theorem."""
+    rng = np.random.default_rng(seed)
+    amplitudes = rng.rayleigh(1.0, lines)
+    amplitudes *= rms / np.sqrt(np.sum(amplitudes**2) / 2)
+    return SineSum(amplitudes, 2 * np.pi * rng.uniform(f_min, f_max, lines), rng.uniform(0, 2 * np.pi, lines),
+                   t_ramp=t_ramp)
+
+
+@dataclass(frozen=True)
+class SteppedSine:
+    """A stepped sine as a sine-test controller plays it: `amplitude` (the signal's unit) at each frequency
+    of `frequencies` [Hz] for `dwell_s` seconds, the phase continuous across a step, ramped in from rest over
+    t_ramp [s]; after the last step the last frequency holds. Works on numpy arrays and CasADi expressions."""
+
+    frequencies: tuple
+    dwell_s: float
+    amplitude: float = 1.0
+    t_ramp: float = 0.5
+    kind = -1  # not a built-in FMU excitation
+
+    def frequency(self, t):
+        """Instantaneous frequency [Hz] (numpy)."""
+        step = np.clip(np.floor(np.asarray(t, float) / self.dwell_s).astype(int), 0, len(self.frequencies) - 1)
+        return np.asarray(self.frequencies, float)[step]
+
+    def phase(self, t):
+        """Phase [rad]: 2 pi sum_j f_j (time spent in step j up to t)."""
+        if _is_symbolic(t):
+            import casadi as ca
+
+            clip = lambda x, hi: ca.fmin(ca.fmax(x, 0.0), hi)  # noqa: E731
+        else:
+            clip = lambda x, hi: np.clip(x, 0.0, hi)  # noqa: E731
+        last = len(self.frequencies) - 1
+        return 2 * np.pi * sum(f * clip(t - j * self.dwell_s, np.inf if j == last else self.dwell_s)
+                               for j, f in enumerate(self.frequencies))
+
+    def __call__(self, t):
+        xp = _ops(t)
+        return self.amplitude * Excitation(1, t_ramp=self.t_ramp).envelope(t) * xp.sin(self.phase(t))
 
 
 def motion_with_derivatives(exc: Excitation, t: np.ndarray, names: tuple[str, ...]) -> dict[str, np.ndarray]:

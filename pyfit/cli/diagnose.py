@@ -42,14 +42,15 @@ def add_arguments(ap) -> None:
     ap.add_argument("--uncertainty", type=float, help="with --impedance: the test's relative measurement error "
                     "(RMS of |Z_meas/Z_true - 1|; default: `uncertainty` of the test's sidecar)")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2], help="noise seeds of the null cases")
-    ap.add_argument("--excitation", choices=["multisine", "sweep", "impedance"], default="multisine",
-                    help="with --make-datasets: steady multisine periods, a 35 s sweep from rest, or (--model "
-                         "damper) an impedance test")
+    ap.add_argument("--excitation", choices=["multisine", "sweep", "stepped_sine", "noise", "impedance"],
+                    default="multisine", help="with --make-datasets: steady multisine periods, a 35 s sweep, "
+                    "stepped sine (sdof) or band-limited noise from rest, or (--model damper) an impedance test")
     ap.add_argument("--record", nargs="+", metavar="OUTPUT", help="with --make-datasets: the outputs recorded "
                     "(default: displacements; e.g. a, or acc_x1 acc_x2)")
-    ap.add_argument("--campaign", type=int, metavar="N", help="validation campaign: draw N random SDOF cases "
-                    "(effects, pairs, nulls; strengths, loop shapes, excitation, sensor), write and diagnose each, "
-                    "summarise (confusion matrix, detection limit, false alarms) in OUT/summary.md; resumes")
+    ap.add_argument("--campaign", type=int, metavar="N", help="validation campaign: draw N random cases of --model "
+                    "(effects, pairs, nulls; strengths, loop shapes, excitation, sensors; a damper's geometry), "
+                    "write and diagnose each, summarise (confusion matrix, detection limit, false alarms) in "
+                    "OUT/summary.md; resumes")
     ap.add_argument("--campaign-seed", type=int, default=0, help="with --campaign: the draw's seed")
     ap.add_argument("--calibrate", action="store_true", help="with --campaign: its hit rates become the confidence "
                     "every later report states (stored in the package: pyfit/gap/calibration.json)")
@@ -77,7 +78,7 @@ def run(args, ap) -> int:
             return 0
         if args.campaign:
             campaign.run(args.campaign, args.out, args.fmus, args.campaign_seed, args.workers or 2, args.scheduler,
-                         calibrate=args.calibrate)
+                         calibrate=args.calibrate, model=args.model)
             print((pathlib.Path(args.out) / "summary.md").read_text())
             return 0
         cfg = load_config(args.config) if args.config else None

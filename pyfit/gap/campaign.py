@@ -4,9 +4,10 @@ process pool or a Dask cluster), and judged against what was withheld.
 
 Each case draws: nothing (a null case), one effect or a pair; each effect's strength log-uniformly from
 `STRENGTH_RANGE` times the family's reference strength (a hysteresis loop of random shape, ν = 1, 2 or 3); the
-excitation (a random-odd multisine or a linear sweep, `sweep_s` long); the output recorded (displacement or
-acceleration); the noise seed. The effect-to-noise ratio of a case is measured, not set: the nominal model's
-held-out misfit over the noise floor, both from the report.
+excitation (two periods of a random-odd multisine, or a linear sweep, a stepped sine or band-limited noise
+from rest, `record_s` long: records shorter than a test campaign's, to keep 200 cases near two hours on two
+cores); the output recorded (displacement or acceleration); the noise seed. The effect-to-noise ratio of a
+case is measured, not set: the nominal model's held-out misfit over the noise floor, both from the report.
 
 The summary holds the confusion matrix (withheld × named), top-1 accuracy by effect-to-noise ratio (the
 detection limit), the false-alarm rate on the null cases, and the hit rate by the report's margin (the
@@ -15,6 +16,7 @@ best candidate's held-out shrink): the calibration a single report's confidence 
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import pathlib
 import time
@@ -24,24 +26,33 @@ import numpy as np
 
 from pyfit.gap import confidence, datasets
 from pyfit.gap.diagnose import DiagnoseConfig, diagnose
+from pyfit.io.nominal import NominalModel
 from pyfit.runtime.batch import map_tasks
 
 EFFECTS = ("hysteresis", "cubic_stiffness", "coulomb_friction", "quadratic_damping")
 STRENGTH_RANGE = (0.05, 2.0)  # factor on the family's reference strength, drawn log-uniformly
 SHARES = {"none": 0.2, "single": 0.6, "pair": 0.2}  # how often a case withholds nothing, one effect, two
 ENR_BINS = (0.0, 2.0, 5.0, 10.0, 20.0, np.inf)  # effect-to-noise ratio bins of the detection-limit table
+DAMPER_EXCITATIONS = ("multisine", "sweep", "noise")  # a clamp displacement cannot step
+RECORD_S, PERIODS = 6.0, 2  # a sweep's, stepped sine's or noise record's length [s]; multisine periods kept
 
 
 @dataclass(frozen=True)
 class Case:
-    """One drawn case: what is withheld (a '+'-joined name, 'none'), its truth parameters, how it is recorded."""
+    """One drawn case: what is withheld (a '+'-joined name, 'none'), its truth parameters, how it is recorded;
+    for a damper also its geometry (FMU parameters, the messenger's EI among them), the clamp motion recorded
+    and the test band [Hz]."""
 
     index: int
     withheld: str
     truth: dict
     excitation: str
-    output: str
+    outputs: tuple
     seed: int
+    model: str = "sdof"
+    base: dict | None = None
+    motion: str = "xva"
+    band_hz: tuple | None = None
 
 
 def _hysteresis(rng) -> dict:
@@ -70,8 +81,46 @@ def _effect_truth(effect: str, rng) -> dict:
     return {**ref, strength: ref[strength] * factor}
 
 
-def draw(n: int, seed: int = 0) -> list[Case]:
-    """n SDOF cases drawn with numpy's generator from `seed` (the same n and seed give the same cases)."""
+def _damper_effect_truth(effect: str, rng) -> dict:
+    """One damper effect's truth at a random strength (STRENGTH_RANGE times the damper family's reference);
+    hysteresis with a loop shape drawn across the family (a_bw 0.1-0.6, β 0.3-1.2, γ −0.2-0.6, ν = 1, D
+    0.15-0.4 mm), away from the candidate's starts."""
+    factor = float(np.exp(rng.uniform(*np.log(STRENGTH_RANGE))))
+    ref = datasets.DAMPER.withheld[effect]
+    strengths = {"hysteresis": ("k_bw1", "k_bw2"), "cubic_stiffness": ("k_cs1", "k_cs2"),
+                 "coulomb_friction": ("F_c1", "F_c2"), "quadratic_damping": ("c2_1", "c2_2")}[effect]
+    truth = {**ref, **{k: ref[k] * factor for k in strengths}}
+    if effect == "hysteresis":
+        truth.update(a_bw=rng.uniform(0.1, 0.6), beta=rng.uniform(0.3, 1.2), gamma=rng.uniform(-0.2, 0.6), nu=1.0,
+                     D=rng.uniform(1.5e-4, 4e-4))
+    return {k: float(v) for k, v in truth.items()}
+
+
+def damper_geometry(rng) -> tuple[dict, tuple]:
+    """A catalogue damper drawn at random: masses 0.5-4 kg, arms 0.1-0.3 m, mass offsets 0-50 mm, radii of
+    gyration 30-60 mm, the messenger's EI 5-60 N·m² (log-uniform); drawn again until its two lowest resonances
+    (pyfit.reference.models.damper_modes_hz) lie within 4-60 Hz, as a catalogue damper's do. Returns the FMU
+    parameters and the test band [Hz] a lab would sweep: half the lowest resonance to 2.2 times the second."""
+    from pyfit.reference.models import damper_modes_hz
+
+    while True:
+        g = {}
+        for i in (1, 2):
+            g[f"m{i}"], g[f"L{i}"], g[f"a{i}"] = rng.uniform(0.5, 4.0), rng.uniform(0.1, 0.3), rng.uniform(0.0, 0.05)
+            g[f"J_G{i}"] = g[f"m{i}"] * rng.uniform(0.03, 0.06) ** 2
+        g["EI"] = np.exp(rng.uniform(np.log(5.0), np.log(60.0)))
+        f = damper_modes_hz(g)
+        if f[0] >= 4.0 and f[1] <= 60.0:
+            return {k: float(v) for k, v in g.items()}, (round(float(0.5 * f[0]), 2), round(float(2.2 * f[1]), 2))
+
+
+DAMPER_OUTPUTS = (("x1", "x2"), ("acc_x1", "acc_x2"), ("F_clamp", "acc_x1"), ("acc_xg1", "acc_xg2"))
+DAMPER_MOTIONS = ("x", "a", "xva")  # clamp displacement, acceleration, or all three (a shaker controller)
+
+
+def draw(n: int, seed: int = 0, model: str = "sdof") -> list[Case]:
+    """n cases of `model` ('sdof' or 'damper') drawn with numpy's generator from `seed` (the same n, seed and
+    model give the same cases)."""
     rng = np.random.default_rng(seed)
     cases = []
     for i in range(n):
@@ -79,9 +128,16 @@ def draw(n: int, seed: int = 0) -> list[Case]:
         effects = [] if kind == "none" else list(rng.choice(EFFECTS, 1 if kind == "single" else 2, replace=False))
         truth = {}
         for e in effects:
-            truth.update(_effect_truth(e, rng))
-        cases.append(Case(i, "+".join(sorted(effects)) or "none", truth, str(rng.choice(["multisine", "sweep"])),
-                          str(rng.choice(["y", "a"])), int(rng.integers(1 << 30))))
+            truth.update(_effect_truth(e, rng) if model == "sdof" else _damper_effect_truth(e, rng))
+        withheld = "+".join(sorted(effects)) or "none"
+        if model == "sdof":
+            cases.append(Case(i, withheld, truth, str(rng.choice(datasets.EXCITATIONS)),
+                              (str(rng.choice(["y", "a"])),), int(rng.integers(1 << 30))))
+            continue
+        base, band = damper_geometry(rng)
+        cases.append(Case(i, withheld, truth, str(rng.choice(DAMPER_EXCITATIONS)),
+                          DAMPER_OUTPUTS[rng.integers(len(DAMPER_OUTPUTS))], int(rng.integers(1 << 30)), "damper",
+                          base, str(rng.choice(DAMPER_MOTIONS)), band))
     return cases
 
 
@@ -90,7 +146,7 @@ class CaseJob:
     case: Case
     out: str
     fmu_dir: str
-    sweep_s: float
+    record_s: float
 
 
 def run_case(job: CaseJob) -> dict:
@@ -102,12 +158,18 @@ def run_case(job: CaseJob) -> dict:
         return json.loads(done.read_text())
     c = job.case
     t0 = time.perf_counter()
-    style = datasets.LabStyle(c.excitation, (c.output,), sweep_s=job.sweep_s)
-    data = datasets.write_dataset(folder / "data", datasets.SDOF, c.withheld, seed=c.seed, style=style,
-                                  truth=c.truth or None)
+    family = datasets.FAMILIES[c.model]
+    if c.band_hz:
+        family = dataclasses.replace(family, band_hz=tuple(c.band_hz))
+    style = datasets.LabStyle(c.excitation, tuple(c.outputs), c.motion, record_s=job.record_s)
+    data = datasets.write_dataset(folder / "data", family, c.withheld, seed=c.seed, periods=PERIODS, style=style,
+                                  base=c.base, truth=c.truth or None)
+    # the user describes the damper's geometry; the messenger's EI and damping are what the nominal calibrates
+    described = NominalModel(c.model, {k: v for k, v in c.base.items() if k != "EI"}) if c.base else None
     written = time.perf_counter() - t0
     try:
-        rep = diagnose("sdof", data, folder / "diagnosis", DiagnoseConfig(), job.fmu_dir, workers=1, progress=False)
+        rep = diagnose(c.model, data, folder / "diagnosis", DiagnoseConfig(), job.fmu_dir, workers=1,
+                       progress=False, nominal=described)
         named, gap = rep["chosen_effect"], rep["gap"]
         top = rep["ranking"][0]["shrink_pct"] if rep["ranking"] else None
         outcome = {"named": "+".join(sorted((named or "").split(" + "))) or "none", "verdict": rep["verdict"],
@@ -122,20 +184,25 @@ def run_case(job: CaseJob) -> dict:
     return outcome
 
 
-def command(n: int, seed: int) -> str:
+def command(n: int, seed: int, model: str = "sdof") -> str:
     """The command line that runs this campaign."""
-    return f"stockbridge diagnose --campaign {n} --campaign-seed {seed}"
+    return f"stockbridge diagnose --campaign {n} --campaign-seed {seed}" + ("" if model == "sdof" else
+                                                                           f" --model {model}")
 
 
-def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=None, sweep_s: float = 15.0,
-        progress: bool = True, calibrate: bool = False) -> dict:
-    """Draw n cases and diagnose them: on `scheduler` (a Dask scheduler address) when given, else on a Dask
-    LocalCluster of `workers` single-threaded processes. Writes OUT/summary.md and OUT/summary.json; with
-    `calibrate`, its hit rates become the package's confidence calibration (pyfit.gap.confidence)."""
-    stated_from = confidence.load()
+def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=None, record_s: float = RECORD_S,
+        progress: bool = True, calibrate: bool = False, model: str = "sdof") -> dict:
+    """Draw n cases of `model` and diagnose them: on `scheduler` (a Dask scheduler address) when given, else on
+    a Dask LocalCluster of `workers` single-threaded processes. Writes OUT/summary.md and OUT/summary.json; with
+    `calibrate` (SDOF cases only: the confidence is stated for SDOF diagnoses), its hit rates become the
+    package's confidence calibration (pyfit.gap.confidence)."""
+    if calibrate and model != confidence.FAMILY:
+        raise ValueError(f"--calibrate: the package's calibration is of {confidence.FAMILY} cases; the campaign "
+                         f"is of {model}")
+    stated_from = confidence.load() if model == confidence.FAMILY else None
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    jobs = [CaseJob(c, str(out), str(fmu_dir), sweep_s) for c in draw(n, seed)]
+    jobs = [CaseJob(c, str(out), str(fmu_dir), record_s) for c in draw(n, seed, model)]
     t0 = time.perf_counter()
     if scheduler is None:
         from distributed import Client, LocalCluster
@@ -148,11 +215,11 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
         outcomes = map_tasks(run_case, jobs, scheduler=scheduler, progress=progress, desc="campaign")
         where = f"Dask scheduler {scheduler}"
     summary = summarise(outcomes)
-    summary.update({"cases": n, "seed": seed, "sweep_s": sweep_s, "wall_s": time.perf_counter() - t0,
-                    "where": where, "command": command(n, seed),
+    summary.update({"cases": n, "seed": seed, "record_s": record_s, "wall_s": time.perf_counter() - t0,
+                    "where": where, "command": command(n, seed, model), "model": model,
                     "stated_from": {k: stated_from[k] for k in ("source", "seed", "cases")} if stated_from else None})
     if calibrate:
-        confidence.write(confidence.calibration_of(outcomes, command(n, seed), seed))
+        confidence.write(confidence.calibration_of(outcomes, command(n, seed, model), seed))
     (out / "summary.json").write_text(json.dumps({**summary, "outcomes": outcomes}, indent=1, default=float))
     (out / "summary.md").write_text(markdown(summary))
     return summary
@@ -187,7 +254,8 @@ def _share(part: int, whole: int) -> str:
 
 def markdown(s: dict) -> str:
     """The campaign summary as Markdown."""
-    lines = [f"{s['cases']} SDOF cases (seed {s['seed']}, sweeps {s['sweep_s']:g} s), {s['where']}: wall "
+    system = {"sdof": "SDOF", "damper": "damper (random geometry)"}[s.get("model", "sdof")]
+    lines = [f"{s['cases']} {system} cases (seed {s['seed']}, records {s['record_s']:g} s), {s['where']}: wall "
              f"{s['wall_s'] / 60:.1f} min, median {s['median_case_s']:.0f} s per case (writing the files and "
              f"diagnosing); command: `{s['command']}`.", "",
              f"Top-1 accuracy on the {s['effect_cases']} cases with a withheld effect: {100 * s['top1']:.0f} %; "

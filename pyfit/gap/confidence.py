@@ -17,6 +17,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 CALIBRATION = pathlib.Path(__file__).with_name("calibration.json")
+FAMILY = "sdof"  # the system the calibration's campaign draws: a diagnosis of another states no confidence
 SHRINK_BINS = (-np.inf, 50.0, 80.0, 95.0, np.inf)  # the named model's held-out shrink [%]
 STATED_BINS = (0.0, 0.5, 0.8, 0.95, 1.0 + 1e-9)  # stated confidence, for the check against the hit rate
 

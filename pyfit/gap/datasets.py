@@ -19,7 +19,8 @@ import numpy as np
 
 from pyfit.io.data import write_measurement
 from pyfit.io.impedance import write_impedance
-from pyfit.analysis.excitation import Excitation, PeriodicSignal, motion_with_derivatives, multisine
+from pyfit.analysis.excitation import (Excitation, PeriodicSignal, SteppedSine, band_noise,
+                                       motion_with_derivatives, multisine)
 from pyfit.reference.synthetic import UNITS, SyntheticSpec, simulate_truth
 
 
@@ -65,6 +66,8 @@ DAMPER = Family(
 
 FAMILIES = {"sdof": SDOF, "damper": DAMPER}
 PERIODS = 3
+EXCITATIONS = ("multisine", "sweep", "stepped_sine", "noise")  # of write_dataset (LabStyle.excitation)
+STEPS = 16  # frequencies of a stepped sine
 # CVODES tolerances of the truth: against 1e-10 / 1e-14 the SDOF records change by at most 1.5e-6 of the
 # output's standard deviation, far below the sensor noise (1e-3 of it and more), in a third less time
 TRUTH_RTOL, TRUTH_ATOL = 1e-8, 1e-12
@@ -83,8 +86,11 @@ IMPEDANCE_UNCERTAINTY = 0.01
 @dataclass(frozen=True)
 class LabStyle:
     """How a test bench would have recorded a case: the excitation ('multisine': steady-state periods;
-    'sweep': a linear sweep over the family's band from rest, sweep_s long, constant force amplitude for the
-    SDOF and constant clamp-velocity amplitude for the damper; 'impedance': the damper's characteristic
+    'sweep': a linear sweep over the family's band from rest, record_s long, constant force amplitude for the
+    SDOF and constant clamp-velocity amplitude for the damper; 'stepped_sine': STEPS log-spaced frequencies
+    over the band, record_s / STEPS each, at the sweep's force amplitudes (SDOF only: a clamp displacement
+    would jump at a step); 'noise': band-limited random noise over the band from rest, record_s long, at the
+    multisine's RMS levels; 'impedance': the damper's characteristic
     test, see write_impedance_case), the outputs recorded (None: the family's
     displacements; e.g. ("a",) or ("acc_x1", "acc_x2") for accelerometers) and which of the clamp's x, v,
     a were recorded (the damper's shaker controller gives all three; an accelerometer only 'a')."""
@@ -92,7 +98,7 @@ class LabStyle:
     excitation: str = "multisine"
     outputs: tuple | None = None
     motion: str = "xva"
-    sweep_s: float = 35.0
+    record_s: float = 35.0  # length of a sweep, stepped-sine or noise record [s]
 
 
 def _truth_params(family: Family, effect: str, base: dict, truth: dict | None = None) -> dict:
@@ -118,8 +124,9 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     if truth is None and any(e not in family.withheld for e in effect.split("+")):
         raise ValueError(f"effect '{effect}' unknown for {family.model}; allowed: {', '.join(family.withheld)} "
                          "(or several joined by '+', or the truth's parameters given)")
-    if style.excitation not in ("multisine", "sweep"):
-        raise ValueError(f"excitation '{style.excitation}' unknown; allowed: multisine, sweep")
+    allowed = EXCITATIONS if family.model == "SDOFBoucWen" else ("multisine", "sweep", "noise")
+    if style.excitation not in allowed:
+        raise ValueError(f"excitation '{style.excitation}' unknown for {family.model}; allowed: {', '.join(allowed)}")
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     truth = _truth_params(family, effect, base or {}, truth)
@@ -127,16 +134,20 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     spp, fs, lead = family.samples_per_period, family.fs, family.lead_periods
     rng = np.random.default_rng(seed)
     changes = {}
-    sweep = style.excitation == "sweep"
-    levels, unit = SWEEP_LEVELS[family.model] if sweep else (family.levels, family.level_unit)
+    kind, (f0, f1) = style.excitation, family.band_hz
+    amplitude = kind in ("sweep", "stepped_sine")  # levels are amplitudes (else RMS values)
+    levels, unit = SWEEP_LEVELS[family.model] if amplitude else (family.levels, family.level_unit)
     for i, level in enumerate(levels):
-        if sweep:
-            f0, f1 = family.band_hz
-            kind = 2 if family.model == "SDOFBoucWen" else 4
-            signal = Excitation(kind, level, f0, f1, (f1 - f0) / (style.sweep_s - 1.0), t_ramp=1.0)
-            stop, keep = style.sweep_s, slice(0, int(round(style.sweep_s * fs)))
+        stop, keep = style.record_s, slice(0, int(round(style.record_s * fs)))
+        if kind == "sweep":
+            signal = Excitation(2 if family.model == "SDOFBoucWen" else 4, level, f0, f1,
+                                (f1 - f0) / (style.record_s - 1.0), t_ramp=1.0)
+        elif kind == "stepped_sine":
+            signal = SteppedSine(tuple(np.geomspace(f0, f1, STEPS)), style.record_s / STEPS, level)
+        elif kind == "noise":
+            signal = band_noise(f0, f1, level, seed)
         else:
-            signal = PeriodicSignal(multisine(spp, fs, *family.band_hz, level, seed, odd=True), fs)
+            signal = PeriodicSignal(multisine(spp, fs, f0, f1, level, seed, odd=True), fs)
             stop, keep = (lead + periods + 1) * spp / fs, slice(lead * spp, (lead + periods) * spp)
         physical = {k: v for k, v in truth.items() if k != "sensor_delay"}  # the delay is in the recording
         t, exact, _ = simulate_truth(SyntheticSpec(family.model, signal, stop, fs, list(recorded), physical,
@@ -155,26 +166,36 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
         if family.model == "SDOFBoucWen":
             inputs = {"u_meas": (signal(t_in), "N", "u")}
         else:
-            motion = (motion_with_derivatives(signal, t_in, ("x", "v", "a")) if sweep else
-                      {"x": signal(t_in), "v": signal.derivative(t_in, 1), "a": signal.derivative(t_in, 2)})
+            motion = ({"x": signal(t_in), "v": signal.derivative(t_in, 1), "a": signal.derivative(t_in, 2)}
+                      if kind == "multisine" else motion_with_derivatives(signal, t_in, ("x", "v", "a")))
             inputs = {f"{var}_meas": (motion[k], u, var) for k, u, var in
                       (("x", "m", "x_base"), ("v", "m/s", "v_base"), ("a", "m/s2", "a_base")) if k in style.motion}
         outputs = {f"{o}_meas": (exact[o][keep] + rng.normal(0.0, _noise_of(family, o, clean[o][keep]), len(tk)),
                                  UNITS.get(o, "m"), o) for o in recorded}
         shown = level * 1e3 if unit == "mm" else level
         name = f"level{i + 1}_{shown:g}{unit.replace('/', '')}.csv"
-        exc_meta = ({"kind": "linear_sweep", "f_start": family.band_hz[0], "f_end": family.band_hz[1],
-                     "amplitude": level} if sweep else
-                    {"kind": "multisine", "samples_per_period": spp, "periods": periods, "f_min": family.band_hz[0],
-                     "f_max": family.band_hz[1], "rms": level, "odd": True})
         write_measurement(out / name, family.model, tk, inputs, outputs,
-                          level=f"{'amplitude' if sweep else 'RMS'} {shown:g} {unit}", level_value=shown,
-                          excitation=exc_meta,
+                          level=f"{'amplitude' if amplitude else 'RMS'} {shown:g} {unit}", level_value=shown,
+                          excitation=_excitation_meta(kind, signal, family, level, spp, periods),
                           notes=f"synthetic: CasADi reference (cvodes) at 10x the sensor rate, zero-phase FIR "
                                 f"anti-alias + decimation, noise {family.noise} m (or its equivalent), seed {seed}")
     (out / "truth.json").write_text(json.dumps({"effect": effect, "params": truth, "seed": seed,
                                                 "style": style.__dict__, "rms_change": changes}, indent=1))
     return out
+
+
+def _excitation_meta(kind: str, signal, family: Family, level: float, spp: int, periods: int) -> dict:
+    """The sidecar's [excitation] table of a record written by write_dataset (frequencies in Hz)."""
+    f0, f1 = family.band_hz
+    if kind == "sweep":
+        return {"kind": "linear_sweep", "f_start": f0, "f_end": f1, "amplitude": level}
+    if kind == "stepped_sine":
+        return {"kind": "stepped_sine", "frequencies": list(signal.frequencies), "dwell_s": signal.dwell_s,
+                "amplitude": level}
+    if kind == "noise":
+        return {"kind": "random", "f_min": f0, "f_max": f1, "rms": level}
+    return {"kind": "multisine", "samples_per_period": spp, "periods": periods, "f_min": f0, "f_max": f1,
+            "rms": level, "odd": True}
 
 
 def write_impedance_case(out_dir, effect: str, seed: int = 0, base: dict | None = None) -> pathlib.Path:

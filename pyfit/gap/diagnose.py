@@ -149,7 +149,7 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
 
 def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, scale, fits: dict, sims: dict, gap,
                   runner, out: pathlib.Path, key: str, workers, progress):
-    """Forward selection while a model's held-out misfit stays above the noise (`noise_factor` x the floor),
+    """Forward selection while a model's held-out misfit is still a significant gap (selection.significant),
     from each of the `cfg.beam` best single effects (by score; a flexible stand-in can lead, the true first
     member come second): extend the model by each of the `cfg.partners` other effects whose sensitivity at that
     model explains most of its calibration residual (the screening repeated there), refit jointly (from each
@@ -160,14 +160,17 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     returns the system with the combined effects among its effects and the model selected (None when nothing
     was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
-    at_noise = cfg.noise_factor * floor
+
+    def left(name):  # a model's held-out misfit is still a gap (the nominal's test): go on adding
+        return selection.significant(after[name], floor, cfg.noise_factor, cfg.min_gap)
+
     after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
 
     def score(name):
         return selection.score(before, after[name], floor, fits[name].n_added)
 
     ranked = sorted(fits, key=lambda n: -score(n))
-    if not ranked or after[ranked[0]] <= at_noise:
+    if not ranked or not left(ranked[0]):
         return system, None
     effects = dict(system.effects)
     named = {frozenset([n]): n for n in fits}  # members -> the name their model is stored under
@@ -178,7 +181,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         after[name] = selection.heldout_nrmse(sims[name], held)
 
     def grow(current):
-        while len(effects[current].members or (current,)) < cfg.max_effects and after[current] > at_noise:
+        while len(effects[current].members or (current,)) < cfg.max_effects and left(current):
             members = list(effects[current].members or (current,))
             # the model so far, refitted on from its own result with a combination's budget: a combination must
             # beat more evaluations of its first member(s), not only the first refit
@@ -205,8 +208,13 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 if fits[combo.name] is None:
                     seeds = (fits[current].params, {**fits[current].params, **{
                         p.name: fits[partner].params[p.name] for p in system.effects[partner].params}})
-                    jobs.append((effect_task(system, combo, fmu, cal, nominal, scale, cfg.refit_budget,
-                                             cfg.upsample, seeds=seeds), str(path), key))
+                    task = effect_task(system, combo, fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
+                                       seeds=seeds)
+                    # never worse than the model it extends (the partner at zero is that model)
+                    added = {q.name for q in system.effects[partner].params}
+                    at_zero = {**task.floor, **{n: v for n, v in fits[current].params.items()
+                                                if n in task.floor and n not in added}}
+                    jobs.append((dataclasses.replace(task, floor=at_zero), str(path), key))
             for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="combinations"):
                 if fit.effect == current:
                     again = fit
@@ -219,7 +227,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 if name not in after or name not in sims:
                     simulated(name)
             best = min(names, key=lambda n: after[n], default=None)
-            if best is None or after[current] <= at_noise or \
+            if best is None or not left(current) or \
                     not selection.adds_enough(after[current], after[best], floor, cfg.min_excess_cut):
                 break  # (the model so far, refitted on, may itself reach the noise: nothing left to add)
             current = best
@@ -232,7 +240,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     ends = []
     for start in ranked[:cfg.beam]:
         ends.append(grow(start))
-        if after[ends[-1]] <= at_noise:
+        if not left(ends[-1]):
             break  # a path that reaches the noise: no other start can do better than the noise
     return dataclasses.replace(system, effects=effects), functools.reduce(kept, ends)
 
@@ -359,7 +367,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
                              selected)
     result["level_order"] = level_order
     top = result["ranking"][0]["shrink_pct"] if result["ranking"] else None
-    result["confidence"] = confidence.stated(result["verdict"], result["chosen_effect"], top, confidence.load())
+    result["confidence"] = (confidence.stated(result["verdict"], result["chosen_effect"], top, confidence.load())
+                            if model == confidence.FAMILY else None)
     result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample, system.lead_periods)
     runner.close()
     clock.end("verdict")

@@ -62,7 +62,7 @@ def nominal_gap(sims: dict, records, held, bands, cfg) -> dict:
     gap["noise_floor_method"] = sorted({e[1] for e in estimates})
     worst = int(np.nanargmax([b["nrmse"] for b in gap["by_band"]]))
     gap["worst_band_hz"] = gap["by_band"][worst]["band_hz"]
-    gap["significant"] = bool(gap["overall"] > max(cfg.noise_factor * floor, floor + cfg.min_gap))
+    gap["significant"] = selection.significant(gap["overall"], floor, cfg.noise_factor, cfg.min_gap)
     return gap
 
 

@@ -15,6 +15,12 @@ def heldout_nrmse(sims: dict, held) -> float:
     return float(np.sqrt(np.mean(np.square(done)))) if done and len(done) == len(held) else float("inf")
 
 
+def significant(nrmse: float, floor: float, noise_factor: float, min_gap: float) -> bool:
+    """Whether a model's held-out misfit is a gap worth explaining: above noise_factor x the noise floor and
+    above the floor + min_gap (the nominal model's test, and the forward selection's test to go on)."""
+    return nrmse > max(noise_factor * floor, floor + min_gap)
+
+
 def shrink_pct(before: float, after: float, reference: float) -> float:
     """How much of the gap above `reference` a model removes, in %: 100 (before - after) / (before - reference)."""
     return 100.0 * (before - after) / (before - reference) if before > reference else 0.0

@@ -282,12 +282,14 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
 
 
 def _toml_value(v) -> str:
-    """A scalar as TOML: quoted string, true/false, or number."""
+    """A value as TOML: quoted string, true/false, number (Python's or numpy's), or an array of these."""
     if isinstance(v, str):
         return f'"{v}"'
-    if isinstance(v, bool):
+    if isinstance(v, (bool, np.bool_)):
         return "true" if v else "false"
-    return f"{v}"
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    return repr(float(v)) if isinstance(v, (float, np.floating)) else f"{int(v)}"
 
 
 def write_measurement(csv_path: str | pathlib.Path, model: str, t: np.ndarray, inputs: dict[str, tuple],

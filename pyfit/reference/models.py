@@ -125,6 +125,17 @@ def damper_matrices(P) -> tuple[ca.SX, ca.SX]:
     return K, M
 
 
+def damper_modes_hz(params: dict) -> np.ndarray:
+    """Undamped natural frequencies [Hz] of the linear damper on a fixed clamp (the four free DOFs of
+    damper_matrices, nonlinear elements off), ascending; params: DAMPER_DEFAULTS names, SI."""
+    import scipy.linalg
+
+    K, M = damper_matrices({**DAMPER_DEFAULTS, **params})
+    free = [0, 1, 4, 5]
+    Kf, Mf = (np.array(ca.evalf(X[free, free])) for X in (K, M))
+    return np.sqrt(np.abs(scipy.linalg.eigh(Kf, Mf, eigvals_only=True))) / (2 * np.pi)
+
+
 def damper() -> ReferenceModel:
     """Stockbridge damper on a shaker (theory §1.3): clamp displacement, velocity, acceleration prescribed."""
     names = list(DAMPER_DEFAULTS)

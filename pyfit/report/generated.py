@@ -74,10 +74,8 @@ RESULTS = {
     "docs/results/bench_diagnose_time.md": ("results/bench/diagnose_time.md", "python bench/diagnose_time.py"),
     "docs/results/bench_fit_time.md": ("results/bench/fit_time.md", "python bench/fit_time.py"),
     "docs/results/campaign.md": ("results/campaign/summary.md",
-                                 "stockbridge diagnose --campaign 20 --calibrate --out results/campaign"),
-    "docs/results/campaign_check.md": ("results/campaign_check/summary.md",
-                                       "stockbridge diagnose --campaign 20 --campaign-seed 1 "
-                                       "--out results/campaign_check"),
+                                 "stockbridge diagnose --campaign 200 --campaign-seed 2 --calibrate "
+                                 "--out results/campaign"),
     "docs/results/bench_peers_fit.md": ("results/bench/peers_fit.md", "python bench/peers_fit.py --seeds 3"),
     "docs/results/bench_peers_diagnosis.md": ("results/bench/peers_diagnosis_quick.md",
                                               "python bench/peers_diagnosis.py --quick"),

@@ -1,0 +1,43 @@
+"""Withheld-effect datasets (pyfit.gap.datasets) with a stepped sine and band-limited noise: what the files
+hold against the signal they were made from, and the excitations a family refuses."""
+import numpy as np
+import pytest
+
+from pyfit.analysis.excitation import SteppedSine, band_noise
+from pyfit.gap import datasets
+from pyfit.io.data import read_measurement
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    root = tmp_path_factory.mktemp("lab")
+    return {kind: datasets.write_dataset(root / kind, datasets.SDOF, "none", seed=3,
+                                         style=datasets.LabStyle(kind, record_s=6.0))
+            for kind in ("stepped_sine", "noise")}
+
+
+def test_a_stepped_sine_file_holds_the_controller_signal_and_its_steps(written):
+    first = read_measurement(sorted(written["stepped_sine"].glob("level1_*.csv"))[0])
+    steps = first.excitation["frequencies"]
+    assert first.excitation["kind"] == "stepped_sine" and len(steps) == datasets.STEPS
+    assert steps[0] == pytest.approx(datasets.SDOF.band_hz[0]) and steps[-1] == pytest.approx(datasets.SDOF.band_hz[1])
+    signal = SteppedSine(tuple(steps), first.excitation["dwell_s"], first.excitation["amplitude"])
+    u = first.by_variable("inputs")["u"]
+    assert first.t[-1] == pytest.approx(6.0, abs=2 / datasets.SDOF.fs)
+    assert np.max(np.abs(u - signal(first.t))) < 1e-9 * first.excitation["amplitude"]  # the file's rounding
+
+
+def test_a_noise_file_holds_band_limited_noise_at_its_level(written):
+    for path in sorted(written["noise"].glob("*.csv")):
+        m = read_measurement(path)
+        assert m.excitation["kind"] == "random"
+        u = m.by_variable("inputs")["u"]
+        assert np.max(np.abs(u - band_noise(m.excitation["f_min"], m.excitation["f_max"], m.excitation["rms"],
+                                            seed=3)(m.t))) < 1e-9 * m.excitation["rms"]
+        # the RMS of 5 s of 150 incommensurate sines scatters about the level by a few %
+        assert np.sqrt(np.mean(u[m.t > 1.0] ** 2)) == pytest.approx(m.excitation["rms"], rel=0.15)
+
+
+def test_a_clamp_driven_damper_refuses_a_stepped_sine(tmp_path):
+    with pytest.raises(ValueError, match="stepped_sine.*allowed: multisine, sweep, noise"):
+        datasets.write_dataset(tmp_path, datasets.DAMPER, "none", style=datasets.LabStyle("stepped_sine"))
