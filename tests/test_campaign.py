@@ -73,6 +73,18 @@ def test_the_summary_counts_what_was_named_against_what_was_withheld():
     assert [(c["reports"], c["right"]) for c in s["check"]] == [(0, 0), (0, 0), (3, 1), (0, 0)]
 
 
+def test_the_summary_splits_singles_from_pairs_and_counts_a_pair_named_as_one_member():
+    pairs = [("cubic_stiffness+hysteresis", "cubic_stiffness+hysteresis"), ("cubic_stiffness+hysteresis", "hysteresis"),
+             ("coulomb_friction+hysteresis", "none"), ("hysteresis", "hysteresis"), ("hysteresis", "none")]
+    outcomes = [{"withheld": w, "named": n, "enr": 10.0, "top_shrink_pct": None, "stated": None, "data_s": 1.0,
+                 "diagnose_s": 1.0, "verdict": ""} for w, n in pairs]
+    s = campaign.summarise(outcomes)
+    assert s["by_size"] == [{"kind": "single effects", "cases": 2, "hits": 1, "one_member": 1},
+                            {"kind": "pairs", "cases": 3, "hits": 1, "one_member": 1}]
+    assert "| pairs | 3 | 33 % | 1 |" in campaign.markdown({**s, "cases": 5, "seed": 0, "record_s": 6.0,
+                                                                 "where": "here", "wall_s": 60.0, "command": "c"})
+
+
 @pytest.mark.slow
 def test_a_short_campaign_on_a_local_dask_cluster(tmp_path, fmu_dir, measured):
     summary = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)

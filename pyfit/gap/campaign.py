@@ -239,7 +239,12 @@ def summarise(outcomes: list[dict]) -> dict:
         by_enr.append({"enr": [ENR_BINS[k], ENR_BINS[k + 1]], "cases": len(inside),
                        "hits": sum(o["named"] == o["withheld"] for o in inside)})
     calibration = confidence.calibration_of(outcomes, "", 0)
-    return {"labels": labels, "confusion": confusion,
+    by_size = []
+    for size, kind in ((1, "single effects"), (2, "pairs")):
+        inside = [o for o in effects if len(o["withheld"].split("+")) == size]
+        by_size.append({"kind": kind, "cases": len(inside), "hits": sum(o["named"] == o["withheld"] for o in inside),
+                        "one_member": sum(o["named"] in o["withheld"].split("+") for o in inside)})
+    return {"labels": labels, "confusion": confusion, "by_size": by_size,
             "top1": sum(o["named"] == o["withheld"] for o in effects) / max(len(effects), 1),
             "effect_cases": len(effects), "null_cases": len(nulls),
             "false_alarms": sum(o["named"] != "none" for o in nulls), "by_enr": by_enr,
@@ -265,6 +270,10 @@ def markdown(s: dict) -> str:
     for w in s["labels"]:
         if any(s["confusion"][w].values()):
             lines.append(f"| {w} | " + " | ".join(str(s["confusion"][w][n] or "·") for n in s["labels"]) + " |")
+    lines += ["", "**By the number withheld**", "", "| withheld | cases | named right | a pair named as one of its "
+              "members |", "|---|---|---|---|"]
+    lines += [f"| {b['kind']} | {b['cases']} | {_share(b['hits'], b['cases'])} | "
+              f"{b['one_member'] if b['kind'] == 'pairs' else '—'} |" for b in s["by_size"]]
     lines += ["", "**Detection limit**: top-1 accuracy by effect-to-noise ratio (nominal held-out misfit over "
               "the noise floor)", "", "| effect-to-noise ratio | cases | named right |", "|---|---|---|"]
     lines += [f"| {confidence.range_label(*b['enr'])} | {b['cases']} | {_share(b['hits'], b['cases'])} |"

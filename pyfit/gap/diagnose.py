@@ -294,10 +294,16 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     records, cal, held, data_key, level_order = _load(data_dir, system, cfg, runner)
     lo, hi = localise.excited_range(records)
     modes = linear_modes(fmu, {**system.nominal_fixed, **system.start(cal)})
-    if modes and not any(lo <= m.f_n <= hi for m in modes):
+
+    def in_band(start):  # a start whose linear model has a resonance in the excited band
+        return any(lo <= m.f_n <= hi for m in linear_modes(fmu, {**system.nominal_fixed, **start}))
+
+    if modes and not any(lo <= m.f_n <= hi for m in modes) and \
+            not any(in_band(s) for s in system.data_starts(cal, lambda p: linear_modes(fmu, p))):
         raise DiagnoseError(f"{data_dir}: the inputs excite {lo:.1f}-{hi:.1f} Hz but the nominal model's resonances "
-                            f"are at {', '.join(f'{m.f_n:.1f}' for m in modes)} Hz; allowed: an excitation band "
-                            "that holds at least one resonance (the data cannot calibrate the model otherwise)")
+                            f"are at {', '.join(f'{m.f_n:.1f}' for m in modes)} Hz and no start from the measured "
+                            "resonance peaks moves one into that band; allowed: an excitation band that holds at "
+                            "least one resonance (the data cannot calibrate the model otherwise)")
     clock.end("reading and checking the data")
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)

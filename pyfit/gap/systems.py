@@ -270,9 +270,10 @@ def _damper_order(name: str) -> int:
 
 
 def damper_modal_starts(records, base: dict, modes_of, max_starts: int = 8) -> list[dict]:
-    """Starts that put the model's lowest resonance in the excited band onto each resonance peak the records
-    show (pyfit.analysis.modal.frf_peaks of every output over the clamp displacement, from the whole record
-    and from Welch segments): EI scaled by
+    """Starts that put the model's lowest resonance in the excited band (its lowest resonance when none is in
+    the band: a described damper whose messenger EI is far off) onto each resonance peak the records show
+    (pyfit.analysis.modal.frf_peaks of every output over the clamp displacement, from the whole record and
+    from Welch segments): EI scaled by
     (f_peak / f_model)^2 (the stiffness matrix is proportional to EI) and the Rayleigh coefficients alpha_pd,
     beta_pd by zeta_peak / zeta_model (each mode's damping ratio is linear in them). Peaks within 2 % of one
     already taken are skipped; at most max_starts. modes_of: params -> the model's modes (linearised FMU)."""
@@ -280,7 +281,8 @@ def damper_modal_starts(records, base: dict, modes_of, max_starts: int = 8) -> l
     from pyfit.gap.localise import excited_range
 
     lo, hi = excited_range(records)
-    model = [m for m in modes_of(base) if lo <= m.f_n <= hi]
+    modes = modes_of(base)
+    model = [m for m in modes if lo <= m.f_n <= hi] or modes[:1]
     if not model or "EI" not in base:
         return []
     peaks = []

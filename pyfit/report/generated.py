@@ -76,6 +76,9 @@ RESULTS = {
     "docs/results/campaign.md": ("results/campaign/summary.md",
                                  "stockbridge diagnose --campaign 200 --campaign-seed 2 --calibrate "
                                  "--out results/campaign"),
+    "docs/results/campaign_damper.md": ("results/campaign_damper/summary.md",
+                                        "stockbridge diagnose --campaign 6 --model damper --out "
+                                        "results/campaign_damper"),
     "docs/results/bench_peers_fit.md": ("results/bench/peers_fit.md", "python bench/peers_fit.py --seeds 3"),
     "docs/results/bench_peers_diagnosis.md": ("results/bench/peers_diagnosis_quick.md",
                                               "python bench/peers_diagnosis.py --quick"),
