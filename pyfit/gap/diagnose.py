@@ -154,8 +154,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     member come second): extend the model by each of the `cfg.partners` other effects whose sensitivity at that
     model explains most of its calibration residual (the screening repeated there), refit jointly (from each
     member's own refit and the effects' starts), and go on from the best combination when it removes
-    `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted with the same
-    budget, up to `cfg.max_effects` members. Of the ends of these paths, a larger model is selected only by the
+    `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted on with a
+    combination's budget (the combinations start from that refit and never end worse than it), up to `cfg.max_effects` members. Of the ends of these paths, a larger model is selected only by the
     same rule (selection.simpler_or_better). Adds the fits and held-out simulations to `fits` and `sims`;
     returns the system with the combined effects among its effects and the model selected (None when nothing
     was tried)."""
@@ -184,13 +184,18 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         while len(effects[current].members or (current,)) < cfg.max_effects and left(current):
             members = list(effects[current].members or (current,))
             # the model so far, refitted on from its own result with a combination's budget: a combination must
-            # beat more evaluations of its first member(s), not only the first refit
+            # beat more evaluations of its first member(s), not only the first refit; the partners then start from
+            # (and never end worse than) the model so far at its best
             again_path = out / "fits" / f"{current.replace(' + ', '+')}.continued.json"
-            again = _stored(again_path, key)
-            jobs = [] if again else [(effect_task(system, effects[current], fmu, cal, nominal, scale,
-                                                  cfg.refit_budget, cfg.upsample, seeds=(fits[current].params,)),
-                                      str(again_path), key)]
-            names = []
+            again = _stored(again_path, key) or _fit_and_store((
+                effect_task(system, effects[current], fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
+                            seeds=(fits[current].params,)), str(again_path), key))
+            if again.calibration_nrmse < fits[current].calibration_nrmse:
+                fits[current] = again
+                simulated(current)
+            if not left(current):
+                break  # the model so far, refitted on, reaches the noise: nothing left to add
+            jobs, names = [], []
             # the next member: the candidates whose sensitivity at the model so far explains most of its
             # residual on the calibration files (the screening's score test, repeated at that model)
             others = [n for n in system.effects if n not in members and n in fits]
@@ -216,20 +221,13 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                                                 if n in task.floor and n not in added}}
                     jobs.append((dataclasses.replace(task, floor=at_zero), str(path), key))
             for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="combinations"):
-                if fit.effect == current:
-                    again = fit
-                else:
-                    fits[fit.effect] = fit
-            if again.calibration_nrmse < fits[current].calibration_nrmse:
-                fits[current] = again
-                simulated(current)
+                fits[fit.effect] = fit
             for name in names:
                 if name not in after or name not in sims:
                     simulated(name)
             best = min(names, key=lambda n: after[n], default=None)
-            if best is None or not left(current) or \
-                    not selection.adds_enough(after[current], after[best], floor, cfg.min_excess_cut):
-                break  # (the model so far, refitted on, may itself reach the noise: nothing left to add)
+            if best is None or not selection.adds_enough(after[current], after[best], floor, cfg.min_excess_cut):
+                break
             current = best
         return current
 
