@@ -157,8 +157,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted on with a
     combination's budget (the combinations start from that refit and never end worse than it), up to
     `cfg.max_effects` members. Of the ends of these paths, a larger model is selected only by the same rule
-    (selection.simpler_or_better). Adds the fits and held-out simulations to `fits` and `sims`; returns the system with the combined effects among its effects and the model selected (None when nothing
-    was tried)."""
+    (selection.simpler_or_better). Adds the fits and held-out simulations to `fits` and `sims`; returns the
+    system with the combined effects among its effects and the model selected (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
 
     def left(name):  # a model's held-out misfit is still a gap (the nominal's test): go on adding
