@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from pyfit.gap import campaign
+from pyfit.gap import campaign, datasets
 from pyfit.gap.systems import DAMPER_LOOP_STARTS, SDOF_EFFECTS, Scale
 
 
@@ -35,7 +35,7 @@ def test_drawn_dampers_span_the_catalogue_and_their_band_holds_two_resonances():
         assert c.band_hz[0] < f[0] < f[1] < c.band_hz[1] and 4.0 <= f[0] and f[1] <= 60.0
     assert {c.outputs for c in cases} == set(campaign.DAMPER_OUTPUTS)
     assert {c.motion for c in cases} == set(campaign.DAMPER_MOTIONS)
-    assert {c.excitation for c in cases} == set(campaign.DAMPER_EXCITATIONS)
+    assert {c.excitation for c in cases} == set(datasets.CLAMP_EXCITATIONS)
     starts = DAMPER_LOOP_STARTS  # the candidate's default start and its other shape starts
     loops = [c.truth for c in cases if "a_bw" in c.truth]
     assert loops and all(all(abs(lp["a_bw"] - s["a_bw"]) > 1e-6 for s in starts) for lp in loops)

@@ -33,7 +33,6 @@ EFFECTS = ("hysteresis", "cubic_stiffness", "coulomb_friction", "quadratic_dampi
 STRENGTH_RANGE = (0.05, 2.0)  # factor on the family's reference strength, drawn log-uniformly
 SHARES = {"none": 0.2, "single": 0.6, "pair": 0.2}  # how often a case withholds nothing, one effect, two
 ENR_BINS = (0.0, 2.0, 5.0, 10.0, 20.0, np.inf)  # effect-to-noise ratio bins of the detection-limit table
-DAMPER_EXCITATIONS = ("multisine", "sweep", "noise")  # a clamp displacement cannot step
 RECORD_S, PERIODS = 6.0, 2  # a sweep's, stepped sine's or noise record's length [s]; multisine periods kept
 
 
@@ -135,7 +134,7 @@ def draw(n: int, seed: int = 0, model: str = "sdof") -> list[Case]:
                               (str(rng.choice(["y", "a"])),), int(rng.integers(1 << 30))))
             continue
         base, band = damper_geometry(rng)
-        cases.append(Case(i, withheld, truth, str(rng.choice(DAMPER_EXCITATIONS)),
+        cases.append(Case(i, withheld, truth, str(rng.choice(datasets.CLAMP_EXCITATIONS)),
                           DAMPER_OUTPUTS[rng.integers(len(DAMPER_OUTPUTS))], int(rng.integers(1 << 30)), "damper",
                           base, str(rng.choice(DAMPER_MOTIONS)), band))
     return cases

@@ -67,6 +67,7 @@ DAMPER = Family(
 FAMILIES = {"sdof": SDOF, "damper": DAMPER}
 PERIODS = 3
 EXCITATIONS = ("multisine", "sweep", "stepped_sine", "noise")  # of write_dataset (LabStyle.excitation)
+CLAMP_EXCITATIONS = ("multisine", "sweep", "noise")  # of a clamp-driven damper: its displacement cannot step
 STEPS = 16  # frequencies of a stepped sine
 # CVODES tolerances of the truth: against 1e-10 / 1e-14 the SDOF records change by at most 1.5e-6 of the
 # output's standard deviation, far below the sensor noise (1e-3 of it and more), in a third less time
@@ -124,9 +125,10 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     if truth is None and any(e not in family.withheld for e in effect.split("+")):
         raise ValueError(f"effect '{effect}' unknown for {family.model}; allowed: {', '.join(family.withheld)} "
                          "(or several joined by '+', or the truth's parameters given)")
-    allowed = EXCITATIONS if family.model == "SDOFBoucWen" else ("multisine", "sweep", "noise")
+    allowed = EXCITATIONS if family.model == "SDOFBoucWen" else CLAMP_EXCITATIONS
     if style.excitation not in allowed:
-        raise ValueError(f"excitation '{style.excitation}' unknown for {family.model}; allowed: {', '.join(allowed)}")
+        raise ValueError(f"excitation '{style.excitation}' unknown for {family.model}; allowed: "
+                         f"{', '.join(allowed)}")
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     truth = _truth_params(family, effect, base or {}, truth)
