@@ -17,13 +17,13 @@ SEED = 20261125  # the truths of this file: each test draws its own from this se
 
 def _sdof_hysteresis_truths(n: int) -> list[dict]:
     """Bouc-Wen loops of the SDOF family (theory §1.1), drawn across it: the loading branch softening
-    (γ + δ > 0) or, for ν = 1, mildly hardening (as the benchmark's); the unloading branch's γ − δ from 0.2
-    to 2.5 (narrow to wide loops); ν = 1, 2 and 3 in turn; the hysteretic element holding 30-60 % of the stiffness and
-    turning over at 50-500 N (β |z|^ν ≈ α there)."""
+    (γ + δ > 0) or, for ν below 1.5, mildly hardening (as the benchmark's); the unloading branch's γ − δ from
+    0.2 to 2.5 (narrow to wide loops); ν drawn in each third of 1-3 in turn (never the starts' whole values);
+    the hysteretic element holding 30-60 % of the stiffness and turning over at 50-500 N (β |z|^ν ≈ α there)."""
     rng, out = np.random.default_rng(SEED), []
     for i in range(n):
-        nu = (1.0, 2.0, 3.0)[i % 3]  # every sharpness of the transition
-        s = rng.uniform(-0.5, 1.5) if nu == 1.0 else rng.uniform(0.1, 1.5)  # γ + δ: hardening only for ν = 1
+        nu = 1.0 + (i % 3 + rng.uniform(0.05, 0.95)) * 2.0 / 3.0  # every sharpness of the transition
+        s = rng.uniform(-0.5, 1.5) if nu < 1.5 else rng.uniform(0.1, 1.5)  # γ + δ: hardening only for low ν
         d = rng.uniform(0.2, 2.5)  # γ − δ
         k = 1e5 * rng.uniform(0.4, 0.7)
         z_y = 10.0 ** rng.uniform(1.7, 2.7)
@@ -68,15 +68,29 @@ def test_sdof_coulomb_friction_and_cubic_stiffness_are_named_together(tmp_path, 
             assert r["calibration_nrmse"] <= max(calibration[m] for m in r["members"]) * (1 + 1e-12), r["effect"]
 
 
+def test_a_weak_quadratic_damping_beside_a_strong_cubic_spring_is_named(tmp_path, fmu_dir, measured):
+    """A hardening spring that jumps on a sweep and a quadratic damping far below 1 % of its candidate's range
+    (the damping force a few % of the viscous one): the pair is named and c2 recovered."""
+    rng = np.random.default_rng(SEED + 3)
+    truth = {"k3": float(rng.uniform(4e7, 8e7)), "c2": float(rng.uniform(0.4, 1.0))}
+    data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "cubic_stiffness+quadratic_damping", seed=40,
+                                  periods=2, truth=truth, style=datasets.LabStyle("sweep", ("a",), record_s=6.0))
+    rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
+    assert set((rep["chosen_effect"] or "").split(" + ")) == {"cubic_stiffness", "quadratic_damping"}, rep["verdict"]
+    measured("SDOF with a strong cubic spring and a weak quadratic damping on sweeps: fitted c2 relative to the "
+             "withheld value", abs(rep["ranking"][0]["params"]["c2"] / truth["c2"] - 1), 0.1)
+
+
 def test_the_thesis_damper_with_hysteresis_and_softening_springs_is_named_as_both(tmp_path, fmu_dir, measured):
     """The thesis's damper model: Bouc-Wen hysteresis and softening cubic springs, a loop shape drawn at random
     (not the reference damper's), clamp sweeps recorded as displacement."""
     rng = np.random.default_rng(SEED + 2)
     truth = {"k_bw1": float(rng.uniform(400, 800)), "k_bw2": float(rng.uniform(700, 1200)),
              "a_bw": float(rng.uniform(0.1, 0.6)), "beta": float(rng.uniform(0.3, 1.2)),
-             "gamma": float(rng.uniform(-0.2, 0.6)), "nu": 1.0, "D": float(rng.uniform(1.5e-4, 4e-4)),
+             "gamma": float(rng.uniform(-0.2, 0.6)), "nu": float(rng.uniform(1.05, 2.0)),
+             "D": float(rng.uniform(1.5e-4, 4e-4)),
              "k_cs1": -float(rng.uniform(2e6, 5e6)), "k_cs2": -float(rng.uniform(5e6, 1.2e7))}
-    assert _starts_hold_none_of({k: truth[k] for k in ("a_bw", "beta", "gamma")}, DAMPER_EFFECTS["hysteresis"])
+    assert _starts_hold_none_of({k: truth[k] for k in ("a_bw", "beta", "gamma", "nu")}, DAMPER_EFFECTS["hysteresis"])
     data = datasets.write_dataset(tmp_path / "data", datasets.DAMPER, "hysteresis+cubic_stiffness",
                                   style=datasets.LabStyle("sweep", motion="x"), truth=truth)
     rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)

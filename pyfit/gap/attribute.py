@@ -54,6 +54,7 @@ class FitTask:
     floor: dict | None = None  # a point the result must not be worse than (the nominal: the effect at zero)
     derived: tuple = ()  # rules giving fixed parameters from fitted ones (systems.ExponentScaled)
     basin_key: str | None = None  # refit from the best start of each value of this parameter (else the best)
+    probes: int = 1  # without a basin_key: the best starts descended before the best of them goes on
 
 
 class UnitScaling:
@@ -93,6 +94,10 @@ def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, po
 
 
 BASIN_SHARE = 1 / 3  # of a refit's budget, for the probe of each basin before the best goes on
+# share of a parameter's range a least-squares start is moved off its bounds (optim.baselines.polish): an effect
+# strength started at zero whose value is far below 1 % of its range (a weak quadratic damping beside a strong
+# cubic spring) would otherwise start ten times too strong and end worse than zero
+BOUND_MARGIN = 1e-3
 
 
 def run_fit(task: FitTask) -> Fit:
@@ -102,7 +107,8 @@ def run_fit(task: FitTask) -> Fit:
     quarter), then every record. Never worse than the best start: each stage and the last least squares keep
     the best point they evaluated. With task.basin_key the same from the best start of each value of that
     parameter (an SDOF loop, whose ν sets the scale of β, has a basin at each ν), each with BASIN_SHARE of the
-    budget first, then the best of them with the whole budget."""
+    budget first, then the best of them with the whole budget; without it, likewise from the task.probes best
+    starts (a combination's starts lead to different local optima of its many parameters)."""
     t0 = time.perf_counter()
     threads = max(1, min(task.threads, len(task.records)))
     runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
@@ -138,22 +144,27 @@ def run_fit(task: FitTask) -> Fit:
         from the best point so far; never worse than the start."""
         n, whole = 0, budget
         for records, of, part in stages:
-            stage = polish(lambda x: residuals(params(x), records, of), x0, budget=whole // part)
+            stage = polish(lambda x: residuals(params(x), records, of), x0, budget=whole // part,
+                           margin=BOUND_MARGIN)
             e = cost(stage.x)
             x0, e0 = (stage.x, e) if e < e0 else (x0, e0)
             n, budget = n + 1 + stage.n_evaluations, budget - stage.n_evaluations
-        result = polish(lambda x: residuals(params(x)), x0, budget=budget)
+        result = polish(lambda x: residuals(params(x)), x0, budget=budget, margin=BOUND_MARGIN)
         n += result.n_evaluations
         return (result.x, result.error, n) if result.error <= e0 else (x0, e0, n)
 
-    # from the best start; with task.basin_key, from the best start of each of its values, each descended with
-    # a share of the budget (BASIN_SHARE), then the best of them on with the whole budget
+    # from the best start; with task.basin_key, from the best start of each of its values, else from the
+    # task.probes best starts, each descended with a share of the budget (BASIN_SHARE), then the best of them on
+    # with the whole budget
     order = np.argsort(errors)
     best_x, error = candidates[order[0]], errors[order[0]]
+    firsts = {}
     if task.basin_key:
-        firsts = {}
         for k in order:
             firsts.setdefault(round(unit.values(candidates[k])[task.basin_key], 6), k)
+    elif task.probes > 1:
+        firsts = dict(enumerate(order[:task.probes]))
+    if firsts:
         for k in firsts.values():
             x, e, n = descend(candidates[k], errors[k], max(1, int(task.budget * BASIN_SHARE)))
             used += n

@@ -56,10 +56,11 @@ class Case:
 
 def _hysteresis(rng) -> dict:
     """An SDOF Bouc-Wen loop drawn across the family (theory §1.1), independent of the candidate's starts:
-    ν in {1, 2, 3}; the hysteretic element holds 20-70 % of the stiffness 1e5 N/m and turns over at 30-500 N;
-    loading branch softening (γ + δ from 0.1 to 1.5, or mildly hardening for ν = 1), γ − δ from 0.2 to 2.5."""
-    nu = float(rng.choice([1.0, 2.0, 3.0]))
-    s = rng.uniform(-0.5, 1.5) if nu == 1.0 else rng.uniform(0.1, 1.5)
+    ν uniform in 1-3 (never one of the starts' whole values); the hysteretic element holds 20-70 % of the
+    stiffness 1e5 N/m and turns over at 30-500 N; loading branch softening (γ + δ from 0.1 to 1.5, or mildly
+    hardening for ν below 1.5), γ − δ from 0.2 to 2.5."""
+    nu = float(rng.uniform(1.0, 3.0))
+    s = rng.uniform(-0.5, 1.5) if nu < 1.5 else rng.uniform(0.1, 1.5)
     d = rng.uniform(0.2, 2.5)
     alpha = 1e5 * rng.uniform(0.2, 0.7)
     z_y = 10.0 ** rng.uniform(1.5, 2.7)
@@ -82,7 +83,7 @@ def _effect_truth(effect: str, rng) -> dict:
 
 def _damper_effect_truth(effect: str, rng) -> dict:
     """One damper effect's truth at a random strength (STRENGTH_RANGE times the damper family's reference);
-    hysteresis with a loop shape drawn across the family (a_bw 0.1-0.6, β 0.3-1.2, γ −0.2-0.6, ν = 1, D
+    hysteresis with a loop shape drawn across the family (a_bw 0.1-0.6, β 0.3-1.2, γ −0.2-0.6, ν 1-2.5, D
     0.15-0.4 mm), away from the candidate's starts."""
     factor = float(np.exp(rng.uniform(*np.log(STRENGTH_RANGE))))
     ref = datasets.DAMPER.withheld[effect]
@@ -90,8 +91,8 @@ def _damper_effect_truth(effect: str, rng) -> dict:
                  "coulomb_friction": ("F_c1", "F_c2"), "quadratic_damping": ("c2_1", "c2_2")}[effect]
     truth = {**ref, **{k: ref[k] * factor for k in strengths}}
     if effect == "hysteresis":
-        truth.update(a_bw=rng.uniform(0.1, 0.6), beta=rng.uniform(0.3, 1.2), gamma=rng.uniform(-0.2, 0.6), nu=1.0,
-                     D=rng.uniform(1.5e-4, 4e-4))
+        truth.update(a_bw=rng.uniform(0.1, 0.6), beta=rng.uniform(0.3, 1.2), gamma=rng.uniform(-0.2, 0.6),
+                     nu=rng.uniform(1.0, 2.5), D=rng.uniform(1.5e-4, 4e-4))
     return {k: float(v) for k, v in truth.items()}
 
 

@@ -21,7 +21,7 @@ from pyfit.runtime.examples import ensure_fmu
 from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read_toml
 from pyfit.gap import confidence, localise, selection, user_candidates
 from pyfit.gap import simulate as sim
-from pyfit.gap.attribute import Fit, effect_task, nominal_task, run_fit, screen
+from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, nominal_task, run_fit, screen
 from pyfit.gap.systems import combine, family_fmu, make_system
 from pyfit.io.nominal import NominalModel, load_nominal
 
@@ -52,10 +52,12 @@ class DiagnoseConfig:
     partners: int = 4  # candidates tried as the next member of a combination (by the screening at that model)
     beam: int = 2  # single effects the forward selection starts from (the best-scoring ones)
     min_excess_cut: float = 0.5  # share of the misfit above the noise floor a larger combination must remove
+    combination_probes: int = 3  # a combination's best starts each refitted a while before the best goes on
 
 
 _SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
-                   int if f.name in ("nominal_budget", "refit_budget", "upsample", "max_effects", "partners")
+                   int if f.name in ("nominal_budget", "refit_budget", "upsample", "max_effects", "partners",
+                                 "combination_probes")
                    else "number"), False, f.default)
          for f in fields(DiagnoseConfig)}
 
@@ -147,6 +149,21 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
     return None
 
 
+def _combination_seeds(system, current: dict, partner_fit: dict, partner: str, strength: dict) -> tuple[dict, ...]:
+    """Starts of a combination's joint refit, each a model the combination holds: the model so far (`current`:
+    its parameter values, the partner absent); the partner's own refit (the model so far's effects absent: a
+    first effect that over-compensates for the second starts better at zero); the model so far with the
+    partner's parameters from that refit, with the model so far's linear parameters or with the partner's (a
+    hysteretic element's refit moves the linear stiffness: its linear parameters belong with its loop); and the
+    model so far with the partner's strength from the Gauss-Newton step at that model (`strength`, screen's)
+    scaled by attribute.STRENGTH_FACTORS."""
+    own = {p.name for p in system.effects[partner].params}
+    linear = set(system.linear)
+    return ((current, partner_fit, {**current, **{n: partner_fit[n] for n in own}},
+             {**current, **{n: v for n, v in partner_fit.items() if n in own or n in linear}})
+            + tuple({**current, **{n: v * f for n, v in strength.items()}} for f in STRENGTH_FACTORS if strength))
+
+
 def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, scale, fits: dict, sims: dict, gap,
                   runner, out: pathlib.Path, key: str, workers, progress):
     """Forward selection while a model's held-out misfit is still a significant gap (selection.significant),
@@ -199,7 +216,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             # the next member: the candidates whose sensitivity at the model so far explains most of its
             # residual on the calibration files (the screening's score test, repeated at that model)
             others = [n for n in system.effects if n not in members and n in fits]
-            explained, _ = screen(system, fmu, cal, fits[current], scale, cfg.upsample, others)
+            explained, strength = screen(system, fmu, cal, fits[current], scale, cfg.upsample, others)
             for partner in sorted(others, key=lambda n: -explained[n])[:cfg.partners]:
                 together = frozenset(members + [partner])
                 if together in named:  # reached from another single effect
@@ -211,15 +228,16 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 fits[combo.name] = _stored(path, key)
                 names.append(combo.name)
                 if fits[combo.name] is None:
-                    seeds = (fits[current].params, {**fits[current].params, **{
-                        p.name: fits[partner].params[p.name] for p in system.effects[partner].params}})
+                    seeds = _combination_seeds(system, fits[current].params, fits[partner].params, partner,
+                                               strength.get(partner, {}))
                     task = effect_task(system, combo, fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
                                        seeds=seeds)
                     # never worse than the model it extends (the partner at zero is that model)
                     added = {q.name for q in system.effects[partner].params}
                     at_zero = {**task.floor, **{n: v for n, v in fits[current].params.items()
                                                 if n in task.floor and n not in added}}
-                    jobs.append((dataclasses.replace(task, floor=at_zero), str(path), key))
+                    jobs.append((dataclasses.replace(task, floor=at_zero, probes=cfg.combination_probes), str(path),
+                                 key))
             for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="combinations"):
                 fits[fit.effect] = fit
             for name in names:

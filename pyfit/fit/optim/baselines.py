@@ -88,17 +88,18 @@ def differential_evolution(residuals, n_var: int, budget: int, seed: int = 0, po
     return counter.result(reason)
 
 
-def polish(residuals, x0: np.ndarray, budget: int = 200, diff_step: float = 1e-4) -> OptimResult:
+def polish(residuals, x0: np.ndarray, budget: int = 200, diff_step: float = 1e-4, margin: float = 0.01
+           ) -> OptimResult:
     """Local least squares (scipy least_squares, trust-region reflective) on the residual vector.
 
-    The start is moved at least 1 % of the range off the bounds: the trust-region-reflective scaling
-    (Coleman-Li) gives a variable sitting on its bound a zero step, and it then creeps off it by
+    The start is moved at least `margin` (a share of the range) off the bounds: the trust-region-reflective
+    scaling (Coleman-Li) gives a variable sitting on its bound a zero step, and it then creeps off it by
     doubling steps from ~1e-7, which can use the whole budget (seen with an effect started at zero)."""
     counter = CountingResiduals(residuals, budget)
     reason = "converged"
     try:
-        scipy.optimize.least_squares(counter, np.clip(x0, 0.01, 0.99), bounds=(0.0, 1.0), diff_step=diff_step,
-                                     x_scale="jac", max_nfev=budget)
+        scipy.optimize.least_squares(counter, np.clip(x0, margin, 1.0 - margin), bounds=(0.0, 1.0),
+                                     diff_step=diff_step, x_scale="jac", max_nfev=budget)
     except _Budget:
         reason = "budget"
     return counter.result(reason)
