@@ -3,7 +3,7 @@ CasADi reference through pyfit.gap.datasets), written as a lab writes files, dia
 process pool or a Dask cluster), and judged against what was withheld.
 
 Each case draws: nothing (a null case), one effect or a pair; each effect's strength log-uniformly from
-`STRENGTH_RANGE` times the family's reference strength (a hysteresis loop of random shape, ν = 1, 2 or 3); the
+`STRENGTH_RANGE` times the family's reference strength (a hysteresis loop of random shape, ν from 1 to 3); the
 excitation (two periods of a random-odd multisine, or a linear sweep, a stepped sine or band-limited noise
 from rest, `record_s` long: records shorter than a test campaign's, to keep 200 cases near two hours on two
 cores); the output recorded (displacement or acceleration); the noise seed. The effect-to-noise ratio of a
@@ -54,7 +54,7 @@ class Case:
     band_hz: tuple | None = None
 
 
-def _hysteresis(rng) -> dict:
+def hysteresis_loop(rng) -> dict:
     """An SDOF Bouc-Wen loop drawn across the family (theory §1.1), independent of the candidate's starts:
     ν uniform in 1-3 (never one of the starts' whole values); the hysteretic element holds 20-70 % of the
     stiffness 1e5 N/m and turns over at 30-500 N; loading branch softening (γ + δ from 0.1 to 1.5, or mildly
@@ -72,7 +72,7 @@ def _effect_truth(effect: str, rng) -> dict:
     """One effect's truth parameters at a random strength (hysteresis: a random loop, its α the strength)."""
     factor = float(np.exp(rng.uniform(*np.log(STRENGTH_RANGE))))
     if effect == "hysteresis":
-        loop = _hysteresis(rng)
+        loop = hysteresis_loop(rng)
         loop["alpha"] *= min(factor, 1.0)
         loop["k"] = 1e5 - loop["alpha"]
         return loop
@@ -81,7 +81,7 @@ def _effect_truth(effect: str, rng) -> dict:
     return {**ref, strength: ref[strength] * factor}
 
 
-def _damper_effect_truth(effect: str, rng) -> dict:
+def damper_effect_truth(effect: str, rng) -> dict:
     """One damper effect's truth at a random strength (STRENGTH_RANGE times the damper family's reference);
     hysteresis with a loop shape drawn across the family (a_bw 0.1-0.6, β 0.3-1.2, γ −0.2-0.6, ν 1-2.5, D
     0.15-0.4 mm), away from the candidate's starts."""
@@ -128,7 +128,7 @@ def draw(n: int, seed: int = 0, model: str = "sdof") -> list[Case]:
         effects = [] if kind == "none" else list(rng.choice(EFFECTS, 1 if kind == "single" else 2, replace=False))
         truth = {}
         for e in effects:
-            truth.update(_effect_truth(e, rng) if model == "sdof" else _damper_effect_truth(e, rng))
+            truth.update(_effect_truth(e, rng) if model == "sdof" else damper_effect_truth(e, rng))
         withheld = "+".join(sorted(effects)) or "none"
         if model == "sdof":
             cases.append(Case(i, withheld, truth, str(rng.choice(datasets.EXCITATIONS)),

@@ -53,6 +53,7 @@ class DiagnoseConfig:
     beam: int = 2  # single effects the forward selection starts from (the best-scoring ones)
     min_excess_cut: float = 0.5  # share of the misfit above the noise floor a larger combination must remove
     combination_probes: int = 3  # a combination's best starts each refitted a while before the best goes on
+    combination_min_gap: float = 0.0  # NRMSE a model's held-out misfit must exceed beyond the floor to add a member
 
 
 _SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
@@ -166,20 +167,21 @@ def _combination_seeds(system, current: dict, partner_fit: dict, partner: str, s
 
 def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, scale, fits: dict, sims: dict, gap,
                   runner, out: pathlib.Path, key: str, workers, progress):
-    """Forward selection while a model's held-out misfit is still a significant gap (selection.significant),
-    from each of the `cfg.beam` best single effects (by score; a flexible stand-in can lead, the true first
-    member come second): extend the model by each of the `cfg.partners` other effects whose sensitivity at that
-    model explains most of its calibration residual (the screening repeated there), refit jointly (from each
-    member's own refit and the effects' starts), and go on from the best combination when it removes
-    `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted on with a
-    combination's budget (the combinations start from that refit and never end worse than it), up to
-    `cfg.max_effects` members. Of the ends of these paths, a larger model is selected only by the same rule
-    (selection.simpler_or_better). Adds the fits and held-out simulations to `fits` and `sims`; returns the
-    system with the combined effects among its effects and the model selected (None when nothing was tried)."""
+    """Forward selection while a model's held-out misfit is above the noise (selection.significant with
+    `cfg.combination_min_gap`), from each of the `cfg.beam` best single effects (by score; a flexible stand-in
+    can lead, the true first member come second): extend the model by each of the `cfg.partners` other effects
+    whose sensitivity at that model explains most of its calibration residual (the screening repeated there),
+    refit jointly (from each member's own refit and the effects' starts), and go on from the best combination
+    when it removes `min_excess_cut` of the misfit above the floor that the model it extends leaves once
+    refitted on with a combination's budget (the combinations start from that refit and never end worse than
+    it), up to `cfg.max_effects` members. Of the ends of these paths, a larger model is selected only by the
+    same rule (selection.simpler_or_better). Adds the fits and held-out simulations to `fits` and `sims`;
+    returns the system with the combined effects among its effects and the model selected (None when nothing
+    was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
 
-    def left(name):  # a model's held-out misfit is still a gap (the nominal's test): go on adding
-        return selection.significant(after[name], floor, cfg.noise_factor, cfg.min_gap)
+    def left(name):  # a model's held-out misfit is above the noise (a weaker test than the nominal's): go on adding
+        return selection.significant(after[name], floor, cfg.noise_factor, cfg.combination_min_gap)
 
     after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
 
@@ -204,9 +206,10 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             # beat more evaluations of its first member(s), not only the first refit; the partners then start from
             # (and never end worse than) the model so far at its best
             again_path = out / "fits" / f"{current.replace(' + ', '+')}.continued.json"
-            again = _stored(again_path, key) or _fit_and_store((
+            again = _stored(again_path, key) or _fit_and_store((dataclasses.replace(
                 effect_task(system, effects[current], fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
-                            seeds=(fits[current].params,)), str(again_path), key))
+                            seeds=(fits[current].params,)), threads=workers or os.cpu_count() or 1),
+                str(again_path), key))  # it runs alone: its records are simulated at once
             if again.calibration_nrmse < fits[current].calibration_nrmse:
                 fits[current] = again
                 simulated(current)
@@ -324,7 +327,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)
     judging = ("min_gap", "noise_factor", "close_points", "min_shrink_pct", "explain_factor", "explain_margin",
-               "nominal_max_nrmse", "max_effects", "partners", "min_excess_cut", "beam")
+               "nominal_max_nrmse", "max_effects", "partners", "min_excess_cut", "beam", "combination_min_gap")
     # (how results are judged and which combinations are tried, not how a fit is made: stored fits stay valid)
     settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in judging}, sort_keys=True)
     description = json.dumps({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}
@@ -348,7 +351,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
                                 f"{ {n: nominal.params[n] for n in nominal.free} })")
         deflections.append(system.deflection(moved, r))
     scale = system.scale(deflections, cal[0].fs, nominal.params)
-    sims = {"nominal": {r.name: sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods) for r in records}}
+    sims = {"nominal": {r.name: sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods)
+                        for r in records}}
     bands = [tuple(b) for b in cfg.bands_hz] if cfg.bands_hz else localise.default_bands(records)
     gap = report.nominal_gap(sims["nominal"], records, held, bands, cfg)
     clock.end("where (nominal gap)")
@@ -376,6 +380,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
             if fits[name] is None:
                 jobs.append((effect_task(system, system.effects[name], fmu, cal, nominal, scale, cfg.refit_budget,
                                          cfg.upsample, strengths.get(name), linear_starts), str(path), key))
+        jobs.sort(key=lambda job: job[0].basin_key is None)  # the longest (a refit from each basin) first
         for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="refits"):
             fits[fit.effect] = fit
         for name, f in fits.items():  # an effect is judged on the held-out files only
