@@ -98,7 +98,6 @@ def test_a_record_from_rest_is_told_from_a_segment_in_motion_whatever_the_sensor
         assert sim.starts_at_rest(read_measurement(path)) is at_rest, name
 
 
-
 def test_a_periodic_record_is_its_steady_period_repeated(tmp_path, runner, measured):
     """Three periods of a random-odd multisine through a Bouc-Wen loop of random shape, written by the CasADi
     reference: simulated as one steady period after the lead, repeated, the record matches the FMU run over

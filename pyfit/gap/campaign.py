@@ -81,7 +81,7 @@ def _effect_truth(effect: str, rng) -> dict:
     return {**ref, strength: ref[strength] * factor}
 
 
-def damper_effect_truth(effect: str, rng) -> dict:
+def _damper_effect_truth(effect: str, rng) -> dict:
     """One damper effect's truth at a random strength (STRENGTH_RANGE times the damper family's reference);
     hysteresis with a loop shape drawn across the family (a_bw 0.1-0.6, β 0.3-1.2, γ −0.2-0.6, ν 1-2.5, D
     0.15-0.4 mm), away from the candidate's starts."""
@@ -128,7 +128,7 @@ def draw(n: int, seed: int = 0, model: str = "sdof") -> list[Case]:
         effects = [] if kind == "none" else list(rng.choice(EFFECTS, 1 if kind == "single" else 2, replace=False))
         truth = {}
         for e in effects:
-            truth.update(_effect_truth(e, rng) if model == "sdof" else damper_effect_truth(e, rng))
+            truth.update(_effect_truth(e, rng) if model == "sdof" else _damper_effect_truth(e, rng))
         withheld = "+".join(sorted(effects)) or "none"
         if model == "sdof":
             cases.append(Case(i, withheld, truth, str(rng.choice(datasets.EXCITATIONS)),

@@ -101,7 +101,7 @@ def scaled(rec: Record, factor: float) -> Record:
 
 
 # relative error bound of the FMU's adaptive integrator in a diagnosis run: the outputs stay within 1e-4 of their
-# RMS of a 1e-10 run (test_records.py; a tenth or less of a record's sensor noise), at 0.6 the cost of 1e-8
+# RMS of a 1e-10 run (test_records.py), a tenth or less of a record's sensor noise
 TOLERANCE = 1e-6
 
 
