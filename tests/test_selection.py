@@ -37,3 +37,23 @@ def test_a_model_is_extended_only_while_its_misfit_is_a_significant_gap():
     assert selection.significant(0.0144, 0.005, 1.2, 0.005)
     assert not selection.significant(0.058, 0.05, 1.2, 0.005)
     assert selection.significant(0.0611, 0.05, 1.2, 0.005)
+
+
+def test_a_pair_must_beat_what_refitting_on_alone_buys_the_model_it_extends():
+    """Held-out misfits of two campaign cases (stockbridge diagnose --campaign 200 --campaign-seed 5). Case 154,
+    hysteresis alone withheld (floor 0.0084): the loop leaves 0.0127 and every partner added to it 0.0101-0.0106,
+    so the gain is the loop's own parameters refitted on, not the partner. Case 180, hysteresis with quadratic
+    damping withheld (floor 0.0066): the loop leaves 0.0111, the true pair 0.0073, the partner that helps least
+    0.0108."""
+    floor, cut = 0.0084, 0.5
+    control = selection.budget_control([0.0101, 0.0102, 0.0103, 0.0106])
+    assert control == 0.0106
+    assert selection.adds_enough(0.0127, 0.0101, floor, cut)  # against the loop alone the pair would pass ...
+    assert selection.simpler_or_better((1, 0.0127), (2, 0.0101), floor, cut, control) == 0  # ... not the control
+    floor = 0.0066
+    control = selection.budget_control([0.0073, 0.0077, 0.0090, 0.0108])
+    assert selection.simpler_or_better((1, 0.0111), (2, 0.0073), floor, cut, control) == 1
+    # fewer than CONTROL_SIBLINGS partners tried: no control (one or two partners may all genuinely help)
+    assert selection.budget_control([0.0101, 0.0106]) == float("inf")
+    assert selection.simpler_or_better((1, 0.0127), (2, 0.0101), 0.0084, cut,
+                                       selection.budget_control([0.0101, 0.0106])) == 1

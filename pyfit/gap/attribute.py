@@ -53,8 +53,9 @@ class FitTask:
     log_scaled: tuple = ()  # free parameters scaled to their bounds on a log scale (positive, spanning decades)
     floor: dict | None = None  # a point the result must not be worse than (the nominal: the effect at zero)
     derived: tuple = ()  # rules giving fixed parameters from fitted ones (systems.ExponentScaled)
-    basin_key: str | None = None  # refit from the best start of each value of this parameter (else the best)
-    probes: int = 1  # without a basin_key: the best starts descended before the best of them goes on
+    basin: callable = None  # start values -> their basin: refit from the best start of each (a module-level
+    # function, so the task pickles to a worker)
+    probes: int = 1  # without a basin: the best starts descended before the best of them goes on
 
 
 class UnitScaling:
@@ -105,8 +106,8 @@ def run_fit(task: FitTask) -> Fit:
     task.alternatives; with task.continuation in stages, each from the best point so far (by the residual of
     every record): the envelopes of non-periodic records (a third of the budget), the lowest level alone (a
     quarter), then every record. Never worse than the best start: each stage and the last least squares keep
-    the best point they evaluated. With task.basin_key the same from the best start of each value of that
-    parameter (an SDOF loop, whose ν sets the scale of β, has a basin at each ν), each with BASIN_SHARE of the
+    the best point they evaluated. With task.basin the same from the best start of each basin (an SDOF loop
+    has one at each ν, which sets the scale of β, and width: systems.sdof_loop_basin), each with BASIN_SHARE of the
     budget first, then the best of them with the whole budget; without it, likewise from the task.probes best
     starts (a combination's starts lead to different local optima of its many parameters)."""
     t0 = time.perf_counter()
@@ -153,20 +154,21 @@ def run_fit(task: FitTask) -> Fit:
         n += result.n_evaluations
         return (result.x, result.error, n) if result.error <= e0 else (x0, e0, n)
 
-    # from the best start; with task.basin_key, from the best start of each of its values, else from the
+    # from the best start; with task.basin, from the best start of each basin, else from the
     # task.probes best starts, each descended with a share of the budget (BASIN_SHARE), then the best of them on
     # with the whole budget
     order = np.argsort(errors)
     best_x, error = candidates[order[0]], errors[order[0]]
     firsts = {}
-    if task.basin_key:
+    if task.basin:
         for k in order:
-            firsts.setdefault(round(unit.values(candidates[k])[task.basin_key], 6), k)
+            firsts.setdefault(task.basin(unit.values(candidates[k])), k)
     elif task.probes > 1:
         firsts = dict(enumerate(order[:task.probes]))
     if firsts:
         for k in firsts.values():
             x, e, n = descend(candidates[k], errors[k], max(1, int(task.budget * BASIN_SHARE)))
+
             used += n
             if e < error:
                 best_x, error = x, e
@@ -255,7 +257,7 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
                    effect.strengths, budget, upsample, system.lead_periods, tuple(alternatives),
                    log_scaled=tuple(p.name for p in effect.params if p.log), floor=floor,
                    derived=effect.derived(scale),
-                   basin_key=effect.basin_key)
+                   basin=effect.basin)
 
 
 def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int, effects: list,

@@ -174,7 +174,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     refit jointly (from each member's own refit and the effects' starts), and go on from the best combination
     when it removes `min_excess_cut` of the misfit above the floor that the model it extends leaves once
     refitted on with a combination's budget (the combinations start from that refit and never end worse than
-    it), up to `cfg.max_effects` members. Of the ends of these paths, a larger model is selected only by the
+    it) or, when lower, the misfit of the combination whose partner helped least (what the combination's extra
+    evaluations alone buy the model it extends: selection.budget_control), up to `cfg.max_effects` members. Of the ends of these paths, a larger model is selected only by the
     same rule (selection.simpler_or_better). Adds the fits and held-out simulations to `fits` and `sims`;
     returns the system with the combined effects among its effects and the model selected (None when nothing
     was tried)."""
@@ -193,6 +194,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         return system, None
     effects = dict(system.effects)
     named = {frozenset([n]): n for n in fits}  # members -> the name their model is stored under
+    controls = {}  # a combination -> what refitting on alone bought the model it extends (selection.budget_control)
 
     def simulated(name):
         sims[name] = {r.name: sim.simulate(runner, r, fits[name].params, cfg.upsample, system.lead_periods)
@@ -246,15 +248,21 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             for name in names:
                 if name not in after or name not in sims:
                     simulated(name)
+            control = selection.budget_control([after[n] for n in names])
+            for name in names:  # the lowest control any of its refits met
+                controls[name] = min(controls.get(name, float("inf")), control)
             best = min(names, key=lambda n: after[n], default=None)
-            if best is None or not selection.adds_enough(after[current], after[best], floor, cfg.min_excess_cut):
+            if best is None or not selection.adds_enough(min(after[current], controls[best]), after[best], floor,
+                                                         cfg.min_excess_cut):
                 break
             current = best
         return current
 
     def kept(a, b):  # of two path ends, the one a path would keep (selection.simpler_or_better)
         sized = [(len(effects[n].members or (n,)), after[n]) for n in (a, b)]
-        return (a, b)[selection.simpler_or_better(*sized, floor, cfg.min_excess_cut)]
+        larger = (a, b)[sized[1][0] > sized[0][0]]
+        return (a, b)[selection.simpler_or_better(*sized, floor, cfg.min_excess_cut,
+                                                  controls.get(larger, float("inf")))]
 
     ends = []
     for start in ranked[:cfg.beam]:
@@ -380,7 +388,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
             if fits[name] is None:
                 jobs.append((effect_task(system, system.effects[name], fmu, cal, nominal, scale, cfg.refit_budget,
                                          cfg.upsample, strengths.get(name), linear_starts), str(path), key))
-        jobs.sort(key=lambda job: job[0].basin_key is None)  # the longest (a refit from each basin) first
+        jobs.sort(key=lambda job: job[0].basin is None)  # the longest (a refit from each basin) first
         for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="refits"):
             fits[fit.effect] = fit
         for name, f in fits.items():  # an effect is judged on the held-out files only

@@ -7,6 +7,7 @@ import numpy as np
 from pyfit.gap import localise
 
 PENALTY_POINTS = 5.0  # score points charged per strength parameter beyond the first
+CONTROL_SIBLINGS = 3  # extensions of one model needed before the least helpful one serves as a control
 
 
 def heldout_nrmse(sims: dict, held) -> float:
@@ -37,11 +38,21 @@ def adds_enough(smaller_after: float, larger_after: float, floor: float, min_exc
     return larger_after - floor <= (1.0 - min_excess_cut) * (smaller_after - floor)
 
 
-def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, min_excess_cut: float) -> int:
+def budget_control(sibling_nrmse: list[float], min_siblings: int = CONTROL_SIBLINGS) -> float:
+    """What more refit evaluations alone buy a model being extended: the held-out NRMSE of its extension whose
+    added effect helped least (of `min_siblings` or more extensions refitted alike from the same model, the worst
+    one's added effect explains ~nothing, so its gain is the model's own parameters refitted on). inf when fewer
+    extensions were tried (no control)."""
+    return max(sibling_nrmse) if len(sibling_nrmse) >= min_siblings else float("inf")
+
+
+def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, min_excess_cut: float,
+                      control: float = float("inf")) -> int:
     """Of two models given as (number of effects, held-out NRMSE), the index (0: a, 1: b) of the one kept: of
-    two as large, the lower misfit; else the larger only when it adds enough (adds_enough)."""
+    two as large, the lower misfit; else the larger only when it adds enough (adds_enough) to the smaller one
+    credited with what refitting on alone buys it (the larger one's budget_control, when below its misfit)."""
     if a[0] == b[0]:
         return 0 if a[1] <= b[1] else 1
     small, large = (0, 1) if a[0] < b[0] else (1, 0)
     pair = (a, b)
-    return large if adds_enough(pair[small][1], pair[large][1], floor, min_excess_cut) else small
+    return large if adds_enough(min(pair[small][1], control), pair[large][1], floor, min_excess_cut) else small

@@ -76,7 +76,7 @@ class Effect:
     members: tuple = ()  # the single effects of a combination (see `combine`); () for a single effect
     signal_only: bool = False  # acts on the recorded channels, not in the FMU (pyfit.gap.simulate applies it)
     derived: callable = field(default=lambda s: ())  # Scale -> rules giving fixed values from fitted ones
-    basin_key: str | None = None  # a shape parameter with a basin at each of its start values (refit from each)
+    basin: callable = None  # start values -> the basin they lie in (the refit descends from each basin's best)
 
     @property
     def strengths(self) -> int:
@@ -223,13 +223,25 @@ DAMPER_LOOP_STARTS = ({"a_bw": 0.5, "beta": 0.75, "gamma": 0.25, "nu": 1.0},
                       {"a_bw": 0.7, "beta": 1.0, "gamma": 0.0, "nu": 3.0})
 
 HYSTERETIC_FRACTIONS = (0.1, 0.3, 0.6)  # share of the stiffness the hysteretic element holds at small amplitude
+# each shape as listed (a loop that saturates within the data's deflection) and with γ, δ scaled by 0.1 (a wide
+# loop that barely saturates there: a mostly elastic element with a little hysteretic damping). The two lie in
+# separate basins of the least squares (a strong element with a wide loop and a weak one with a narrow loop
+# share the first-order nonlinearity, α·β·γ), so the refit descends from the best start of each
+LOOP_WIDTHS = (1.0, 0.1)
+NARROW_FROM = 0.5  # |γ| + |δ| of a loop start from which it counts as narrow (the listed shapes: 1 to 2)
 
 
 def _sdof_loop_starts(s: Scale) -> list[dict]:
-    """Every loop shape at every hysteretic share of the calibrated stiffness (k + alpha = the nominal k), but
-    the default start (the first shape at the first share)."""
-    return [{"k": (1.0 - f) * s.k, "alpha": f * s.k, **shape} for f in HYSTERETIC_FRACTIONS
-            for shape in SDOF_LOOP_STARTS][1:]
+    """Every loop shape at every width and every hysteretic share of the calibrated stiffness (k + alpha = the
+    nominal k), but the default start (the first shape, as listed, at the first share)."""
+    return [{"k": (1.0 - f) * s.k, "alpha": f * s.k, **{n: v * w if n != "nu" else v for n, v in shape.items()}}
+            for w in LOOP_WIDTHS for f in HYSTERETIC_FRACTIONS for shape in SDOF_LOOP_STARTS
+            if w == 1.0 or f > HYSTERETIC_FRACTIONS[0]][1:]
+
+
+def sdof_loop_basin(values: dict) -> tuple:
+    """The basin an SDOF loop start lies in: its ν (β's scale follows ν) and whether it is narrow or wide."""
+    return round(values["nu"], 6), abs(values["gamma"]) + abs(values["delta"]) >= NARROW_FROM
 
 
 # a lag of the output channels behind the inputs (unsynchronised DAQ modules, different anti-alias filters):
@@ -246,7 +258,7 @@ SDOF_EFFECTS = {
          Param("delta", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["delta"], 5.0)),
          Param("nu", shape=True, range=lambda s: (1.0, SDOF_LOOP_STARTS[0]["nu"], 3.0))),
         derived=lambda s: (ExponentScaled("beta", 1.0 / s.sigma_y, HYSTERETIC_FRACTIONS[1] * s.k * s.sigma_y, "nu"),),
-        basin_key="nu",
+        basin=sdof_loop_basin,
         signature="amplitude-dependent stiffness and damping (hysteresis loops), odd distortion",
         shift_stiffness=0.1, starts=lambda s: _sdof_loop_starts(s)),
     "cubic_stiffness": Effect(
