@@ -107,9 +107,9 @@ def run_fit(task: FitTask) -> Fit:
     every record): the envelopes of non-periodic records (a third of the budget), the lowest level alone (a
     quarter), then every record. Never worse than the best start: each stage and the last least squares keep
     the best point they evaluated. With task.basin the same from the best start of each basin (an SDOF loop
-    has one at each ν, which sets the scale of β, and width: systems.sdof_loop_basin), each with BASIN_SHARE of the
-    budget first, then the best of them with the whole budget; without it, likewise from the task.probes best
-    starts (a combination's starts lead to different local optima of its many parameters)."""
+    has one at each ν, which sets the scale of β, and width: systems.sdof_loop_basin), each with BASIN_SHARE
+    of the budget first, then the best of them with the whole budget; without it, likewise from the
+    task.probes best starts (a combination's starts lead to different local optima of its many parameters)."""
     t0 = time.perf_counter()
     threads = max(1, min(task.threads, len(task.records)))
     runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
@@ -168,7 +168,6 @@ def run_fit(task: FitTask) -> Fit:
     if firsts:
         for k in firsts.values():
             x, e, n = descend(candidates[k], errors[k], max(1, int(task.budget * BASIN_SHARE)))
-
             used += n
             if e < error:
                 best_x, error = x, e

@@ -175,10 +175,10 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     when it removes `min_excess_cut` of the misfit above the floor that the model it extends leaves once
     refitted on with a combination's budget (the combinations start from that refit and never end worse than
     it) or, when lower, the misfit of the combination whose partner helped least (what the combination's extra
-    evaluations alone buy the model it extends: selection.budget_control), up to `cfg.max_effects` members. Of the ends of these paths, a larger model is selected only by the
-    same rule (selection.simpler_or_better). Adds the fits and held-out simulations to `fits` and `sims`;
-    returns the system with the combined effects among its effects and the model selected (None when nothing
-    was tried)."""
+    evaluations alone buy the model it extends: selection.budget_control), up to `cfg.max_effects` members. Of
+    the ends of these paths, a larger model is selected only by the same rule (selection.simpler_or_better).
+    Adds the fits and held-out simulations to `fits` and `sims`; returns the system with the combined effects
+    among its effects and the model selected (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
 
     def left(name):  # a model's held-out misfit is above the noise (a weaker test than the nominal's): go on adding

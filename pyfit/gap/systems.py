@@ -207,9 +207,9 @@ def sdof_stiffness(params: dict) -> float:
 # velocity RMS) to a friction that is still rounding off at half of it; started at 1e-2
 _stick_velocity = Param("v_s", lambda s: (1e-3 * s.sigma_v, 1e-2 * s.sigma_v, 0.5 * s.sigma_v), shape=True, log=True)
 
-# Shapes of the Bouc-Wen loop the refit starts from, spanning the family (theory §1.1 and §1.3): with β fixed
-# at (1/sigma_y)·(k·sigma_y)^(1-ν) (SDOF) or D at sigma_y (damper), the loading branch softens when γ + δ > 0 (SDOF) or β + γ > 0
-# (damper) and hardens otherwise; the unloading branch likewise with γ - δ or β - γ; ν from 1 (smooth) to
+# Shapes of the Bouc-Wen loop the refit starts from, spanning the family (theory §1.1 and §1.3): with β set
+# to (1/sigma_y)·(0.3·k·sigma_y)^(1-ν) (SDOF) or D to sigma_y (damper), the loading branch softens when
+# γ + δ > 0 (SDOF) or β + γ > 0 (damper) and hardens otherwise; the unloading branch likewise with γ - δ or β - γ; ν from 1 (smooth) to
 # 3 (sharp). The refit begins from the best of them on the calibration records and fits the shape.
 SDOF_LOOP_STARTS = ({"gamma": 0.5, "delta": 0.5, "nu": 1.0},    # softening on both branches, wide loop
                     {"gamma": 1.5, "delta": -0.5, "nu": 1.0},   # softening loading, sharp unloading
