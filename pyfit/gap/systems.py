@@ -210,7 +210,8 @@ _stick_velocity = Param("v_s", lambda s: (1e-3 * s.sigma_v, 1e-2 * s.sigma_v, 0.
 # Shapes of the Bouc-Wen loop the refit starts from, spanning the family (theory §1.1 and §1.3): with β set
 # to (1/sigma_y)·(0.3·k·sigma_y)^(1-ν) (SDOF) or D to sigma_y (damper), the loading branch softens when
 # γ + δ > 0 (SDOF) or β + γ > 0 (damper) and hardens otherwise; the unloading branch likewise with γ - δ or
-# β - γ; ν from 1 (smooth) to 3 (sharp). The refit begins from the best of them on the calibration records and fits the shape.
+# β - γ; ν from 1 (smooth) to 3 (sharp). The refit begins from the best of them on the calibration records and
+# fits the shape.
 SDOF_LOOP_STARTS = ({"gamma": 0.5, "delta": 0.5, "nu": 1.0},    # softening on both branches, wide loop
                     {"gamma": 1.5, "delta": -0.5, "nu": 1.0},   # softening loading, sharp unloading
                     {"gamma": 0.5, "delta": -1.5, "nu": 1.0},   # hardening loading, narrow loop
