@@ -27,9 +27,15 @@ def _sdof_hysteresis_truths(n: int) -> list[dict]:
         d = rng.uniform(0.2, 2.5)  # γ − δ
         k = 1e5 * rng.uniform(0.4, 0.7)
         z_y = 10.0 ** rng.uniform(1.7, 2.7)
-        out.append({"k": float(k), "alpha": float(1e5 - k), "beta": float((1e5 - k) / z_y ** nu),
-                    "gamma": float((s + d) / 2), "delta": float((s - d) / 2), "nu": nu})
+        out.append(_loop(float(k), nu, float(s), float(d), float(z_y)))
     return out
+
+
+def _loop(k: float, nu: float, s: float, d: float, z_y: float) -> dict:
+    """SDOF Bouc-Wen truth: linear spring k [N/m] beside a hysteretic element of 1e5 - k that turns over at
+    z_y [N] (β |z|^ν ≈ α there), loading branch γ + δ = s, unloading branch γ − δ = d."""
+    return {"k": k, "alpha": 1e5 - k, "beta": (1e5 - k) / z_y ** nu, "gamma": (s + d) / 2, "delta": (s - d) / 2,
+            "nu": nu}
 
 
 def _starts_hold_none_of(truth: dict, effect) -> bool:
@@ -60,8 +66,7 @@ def test_a_strong_element_with_a_wide_loop_on_long_sweeps_is_named_alone(tmp_pat
     k = 1e5 * float(rng.uniform(0.4, 0.6))
     s, d = float(rng.uniform(-0.5, 0.5)), float(rng.uniform(1.0, 2.5))  # γ + δ, γ - δ
     z_y = float(10.0 ** rng.uniform(3.0, 3.5))
-    truth = {"k": k, "alpha": 1e5 - k, "beta": (1e5 - k) / z_y ** nu, "gamma": (s + d) / 2,
-             "delta": (s - d) / 2, "nu": nu}
+    truth = _loop(k, nu, s, d, z_y)
     assert _starts_hold_none_of(truth, SDOF_EFFECTS["hysteresis"])
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "hysteresis", seed=3, truth=truth,
                                   style=datasets.LabStyle(excitation="sweep"))
