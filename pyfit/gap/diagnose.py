@@ -54,6 +54,8 @@ class DiagnoseConfig:
     min_excess_cut: float = 0.5  # share of the misfit above the noise floor a larger combination must remove
     combination_probes: int = 3  # a combination's best starts each refitted a while before the best goes on
     combination_min_gap: float = 0.0  # NRMSE a model's held-out misfit must exceed beyond the floor to add a member
+    min_partner_explained: float = 0.005  # a model meeting the absolute criterion is extended only when a
+    # candidate's sensitivity explains this share of its calibration residual (the screening at that model)
 
 
 _SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
@@ -170,16 +172,19 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     """Forward selection while a model's held-out misfit is above the noise (selection.significant with
     `cfg.combination_min_gap`), from each of the `cfg.beam` best single effects (by score; a flexible stand-in
     can lead, the true first member come second): extend the model by each of the `cfg.partners` other effects
-    whose sensitivity at that model explains most of its calibration residual (the screening repeated there),
-    refit jointly (from each member's own refit and the effects' starts), and go on from the best combination
-    when it removes `min_excess_cut` of the misfit above the floor that the model it extends leaves once
-    refitted on with a combination's budget (the combinations start from that refit and never end worse than
-    it) or, when lower, the misfit of the combination whose partner helped least (what the combination's extra
+    whose sensitivity at that model explains most of its calibration residual (the screening repeated there;
+    none when the model already meets the absolute criterion and no candidate explains
+    `cfg.min_partner_explained` of that residual: the path and the search end there), refit jointly (from each
+    member's own refit and the effects' starts), and go on from the best combination when it removes
+    `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted on with a
+    combination's budget (the combinations start from that refit and never end worse than it) or, when lower, the misfit of the combination whose partner helped least (what the combination's extra
     evaluations alone buy the model it extends: selection.budget_control), up to `cfg.max_effects` members. Of
     the ends of these paths, a larger model is selected only by the same rule (selection.simpler_or_better).
     Adds the fits and held-out simulations to `fits` and `sims`; returns the system with the combined effects
     among its effects and the model selected (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
+    explained_below = selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin)
+    settled = set()  # models that meet the absolute criterion and leave nothing a candidate's sensitivity explains
 
     def left(name):  # a model's held-out misfit is above the noise (a weaker test than the nominal's): go on adding
         return selection.significant(after[name], floor, cfg.noise_factor, cfg.combination_min_gap)
@@ -222,6 +227,10 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             # residual on the calibration files (the screening's score test, repeated at that model)
             others = [n for n in system.effects if n not in members and n in fits]
             explained, strength = screen(system, fmu, cal, fits[current], scale, cfg.upsample, others)
+            if selection.nothing_to_add(after[current], explained_below, list(explained.values()),
+                                        cfg.min_partner_explained):
+                settled.add(current)  # it explains the data and no candidate explains what is left: done
+                break
             for partner in sorted(others, key=lambda n: -explained[n])[:cfg.partners]:
                 together = frozenset(members + [partner])
                 if together in named:  # reached from another single effect
@@ -267,8 +276,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     ends = []
     for start in ranked[:cfg.beam]:
         ends.append(grow(start))
-        if not left(ends[-1]):
-            break  # a path that reaches the noise: no other start can do better than the noise
+        if not left(ends[-1]) or ends[-1] in settled:
+            break  # a path that reaches the noise, or explains the data with nothing a candidate explains left
     return dataclasses.replace(system, effects=effects), functools.reduce(kept, ends)
 
 
@@ -335,7 +344,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)
     judging = ("min_gap", "noise_factor", "close_points", "min_shrink_pct", "explain_factor", "explain_margin",
-               "nominal_max_nrmse", "max_effects", "partners", "min_excess_cut", "beam", "combination_min_gap")
+               "nominal_max_nrmse", "max_effects", "partners", "min_excess_cut", "beam", "combination_min_gap",
+               "min_partner_explained")
     # (how results are judged and which combinations are tried, not how a fit is made: stored fits stay valid)
     settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in judging}, sort_keys=True)
     description = json.dumps({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}

@@ -21,6 +21,7 @@ import numpy as np
 from pyfit.fit.impedance_objective import model_impedance, relative_residuals
 from pyfit.fit.optim.baselines import polish
 from pyfit.gap.attribute import STIFFNESS_SCAN, UnitScaling, effect_start
+from pyfit.gap import selection
 from pyfit.gap.diagnose import DiagnoseConfig, DiagnoseError, fmu_defaults
 from pyfit.gap.systems import Scale, damper_stiffness, make_system
 from pyfit.io.impedance import ImpedanceTest, read_impedance
@@ -215,7 +216,8 @@ def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu
     for name, fit in fits.items():
         shrink = 100.0 * (gap - fit.heldout_error) / (gap - reference) if gap > reference else 0.0
         explains = (shrink >= cfg.min_shrink_pct
-                    and fit.heldout_error <= max(cfg.explain_factor * floor, floor + cfg.explain_margin))
+                    and fit.heldout_error <= selection.explained_below(floor, cfg.explain_factor,
+                                                                      cfg.explain_margin))
         ranking.append({"effect": name, "score": shrink - 5.0 * (fit.n_added - 1), "shrink_pct": shrink,
                         "heldout_error_after": fit.heldout_error, "calibration_error": fit.calibration_error,
                         "explains": bool(explains), "n_added_params": fit.n_added,
@@ -267,7 +269,8 @@ def report_markdown(rep: dict, cfg: DiagnoseConfig) -> str:
              f"**{rep['heldout_error_nominal']:.4f}**; calibration misfit {rep['nominal']['calibration_error']:.4f}; "
              f"the test's stated uncertainty {floor:.4f}. A gap counts above "
              f"{max(cfg.noise_factor * floor, floor + cfg.min_gap):.4f}; an effect explains it when its held-out "
-             f"misfit is at most {max(cfg.explain_factor * floor, floor + cfg.explain_margin):.4f} and it removes "
+             f"misfit is at most {selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin):.4f} "
+             "and it removes "
              f"at least {cfg.min_shrink_pct:.0f} % of the gap.", "",
              "Nominal: " + ", ".join(f"{n} = {rep['nominal']['params'][n]:.4g}" for n in rep["nominal"]["free"]), "",
              "## Where", "", "| frequency [Hz] | nominal held-out misfit |", "|---|---|"]

@@ -96,7 +96,7 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
                         "n_added_params": fit.n_added, "screening_explained": screening.get(name),
                         "calibration_nrmse": fit.calibration_nrmse, "evaluations": fit.evaluations,
                         "wall_s": fit.wall_s})
-    explained_below = max(cfg.explain_factor * floor, floor + cfg.explain_margin)
+    explained_below = selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin)
     for d in ranking:
         d["explains"] = bool(d["shrink_pct"] >= cfg.min_shrink_pct and d["heldout_gap_after"] <= explained_below)
         if len(d["members"]) > 1:  # each member's share: its own refit's shrink, then what each addition adds

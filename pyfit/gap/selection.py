@@ -22,6 +22,12 @@ def significant(nrmse: float, floor: float, noise_factor: float, min_gap: float)
     return nrmse > max(noise_factor * floor, floor + min_gap)
 
 
+def explained_below(floor: float, explain_factor: float, explain_margin: float) -> float:
+    """The absolute criterion: the held-out NRMSE at or below which a model explains the data,
+    max(explain_factor x the noise floor, the floor + explain_margin)."""
+    return max(explain_factor * floor, floor + explain_margin)
+
+
 def shrink_pct(before: float, after: float, reference: float) -> float:
     """How much of the gap above `reference` a model removes, in %: 100 (before - after) / (before - reference)."""
     return 100.0 * (before - after) / (before - reference) if before > reference else 0.0
@@ -36,6 +42,14 @@ def adds_enough(smaller_after: float, larger_after: float, floor: float, min_exc
     """Whether a model with more effects earns them: it removes at least `min_excess_cut` of the held-out misfit
     above the noise floor that the smaller model leaves."""
     return larger_after - floor <= (1.0 - min_excess_cut) * (smaller_after - floor)
+
+
+def nothing_to_add(nrmse: float, explained_below: float, partner_explained: list[float],
+                   min_partner_explained: float) -> bool:
+    """Whether the forward selection ends at a model: its held-out NRMSE meets the absolute criterion
+    (explained_below) and no candidate's sensitivity at it explains `min_partner_explained` of its calibration
+    residual (the screening repeated at that model: fractions 0-1)."""
+    return nrmse <= explained_below and max(partner_explained, default=0.0) < min_partner_explained
 
 
 def budget_control(sibling_nrmse: list[float], min_siblings: int = CONTROL_SIBLINGS) -> float:
