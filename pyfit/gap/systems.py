@@ -223,21 +223,24 @@ DAMPER_LOOP_STARTS = ({"a_bw": 0.5, "beta": 0.75, "gamma": 0.25, "nu": 1.0},
                       {"a_bw": 0.2, "beta": 0.25, "gamma": 0.75, "nu": 2.0},
                       {"a_bw": 0.7, "beta": 1.0, "gamma": 0.0, "nu": 3.0})
 
-HYSTERETIC_FRACTIONS = (0.1, 0.3, 0.6)  # share of the stiffness the hysteretic element holds at small amplitude
-# each shape as listed (a loop that saturates within the data's deflection) and with γ, δ scaled by 0.1 (a wide
-# loop that barely saturates there: a mostly elastic element with a little hysteretic damping). The two lie in
-# separate basins of the least squares (a strong element with a wide loop and a weak one with a narrow loop
-# share the first-order nonlinearity, α·β·γ), so the refit descends from the best start of each
-LOOP_WIDTHS = (1.0, 0.1)
+DEFAULT_SHARE = 0.1  # share of the stiffness the hysteretic element holds at small amplitude: the default start
+BETA_SHARE = 0.3  # the share that sets β's scale (ExponentScaled)
+# the shares each loop width starts from. As listed (width 1: a loop that saturates within the data's deflection),
+# from a weak element (3 %: it saturates early and adds a little stiffness and damping) to a strong one; with γ,
+# δ scaled by 0.1 (a wide loop that barely saturates there: a mostly elastic element with a little hysteretic
+# damping) at the larger shares only. A strong element with a wide loop and a weak one with a narrow loop share
+# the first-order nonlinearity (α·β·γ) but lie in separate basins of the least squares, so the refit descends
+# from the best start of each
+LOOP_SHARES = {1.0: (0.03, DEFAULT_SHARE, 0.3, 0.6), 0.1: (0.3, 0.6)}
 NARROW_FROM = 0.5  # |γ| + |δ| of a loop start from which it counts as narrow (the listed shapes: 1 to 2)
 
 
 def _sdof_loop_starts(s: Scale) -> list[dict]:
-    """Every loop shape at every width and every hysteretic share of the calibrated stiffness (k + alpha = the
-    nominal k), but the default start (the first shape, as listed, at the first share)."""
+    """Every loop shape at every width and each of its hysteretic shares of the calibrated stiffness (k + alpha =
+    the nominal k), but the default start (the first shape, as listed, at the default share)."""
     return [{"k": (1.0 - f) * s.k, "alpha": f * s.k, **{n: v * w if n != "nu" else v for n, v in shape.items()}}
-            for w in LOOP_WIDTHS for f in HYSTERETIC_FRACTIONS for shape in SDOF_LOOP_STARTS
-            if w == 1.0 or f > HYSTERETIC_FRACTIONS[0]][1:]
+            for w, shares in LOOP_SHARES.items() for f in shares for shape in SDOF_LOOP_STARTS
+            if (w, f, shape) != (1.0, DEFAULT_SHARE, SDOF_LOOP_STARTS[0])]
 
 
 def sdof_loop_basin(values: dict) -> tuple:
@@ -254,11 +257,11 @@ SENSOR_DELAY = Effect(
 SDOF_EFFECTS = {
     "hysteresis": Effect(
         "hysteresis",
-        (Param("alpha", lambda s: (0.0, 0.1 * s.k, 2.0 * s.k)),
+        (Param("alpha", lambda s: (0.0, DEFAULT_SHARE * s.k, 2.0 * s.k)),
          Param("gamma", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["gamma"], 5.0)),
          Param("delta", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["delta"], 5.0)),
          Param("nu", shape=True, range=lambda s: (1.0, SDOF_LOOP_STARTS[0]["nu"], 3.0))),
-        derived=lambda s: (ExponentScaled("beta", 1.0 / s.sigma_y, HYSTERETIC_FRACTIONS[1] * s.k * s.sigma_y, "nu"),),
+        derived=lambda s: (ExponentScaled("beta", 1.0 / s.sigma_y, BETA_SHARE * s.k * s.sigma_y, "nu"),),
         basin=sdof_loop_basin,
         signature="amplitude-dependent stiffness and damping (hysteresis loops), odd distortion",
         shift_stiffness=0.1, starts=lambda s: _sdof_loop_starts(s)),
