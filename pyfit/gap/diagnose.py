@@ -177,11 +177,12 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     `cfg.min_partner_explained` of that residual: the path and the search end there), refit jointly (from each
     member's own refit and the effects' starts), and go on from the best combination when it removes
     `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted on with a
-    combination's budget (the combinations start from that refit and never end worse than it) or, when lower, the misfit of the combination whose partner helped least (what the combination's extra
-    evaluations alone buy the model it extends: selection.budget_control), up to `cfg.max_effects` members. Of
-    the ends of these paths, a larger model is selected only by the same rule (selection.simpler_or_better).
-    Adds the fits and held-out simulations to `fits` and `sims`; returns the system with the combined effects
-    among its effects and the model selected (None when nothing was tried)."""
+    combination's budget (the combinations start from that refit and never end worse than it) or, when lower, the
+    misfit of the combination whose partner helped least (what the combination's extra evaluations alone buy the
+    model it extends: selection.budget_control), up to `cfg.max_effects` members. Of the ends of these paths, a
+    larger model is selected only by the same rule (selection.simpler_or_better). Adds the fits and held-out
+    simulations to `fits` and `sims`; returns the system with the combined effects among its effects and the model
+    selected (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
     explained_below = selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin)
     settled = set()  # models that meet the absolute criterion and leave nothing a candidate's sensitivity explains
