@@ -235,7 +235,7 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
                 budget: int, upsample: int, strength: dict | None = None, linear_starts: tuple = (),
                 seeds: tuple = ()) -> FitTask:
     """The refit of the nominal model with `effect` added, from the best of: the effect's default start; its
-    other shape starts (effect.starts: loop shapes spanning the family); the screening's Gauss-Newton
+    other starts (effect.starts: loop shapes, cubic strengths spanning the family); the screening's Gauss-Newton
     `strength` (parameter -> value) scaled by STRENGTH_FACTORS (the step linearises an effect that is not
     linear in its strength: it can overshoot), each with the calibrated nominal's linear parameters and with
     each of `linear_starts` (e.g. the linear system estimated from the lowest level, where an
@@ -243,11 +243,12 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
     `seeds` (parameter values of earlier fits, e.g. each member's own refit for a combination)."""
     start, bounds, fixed = effect_start(system, effect, scale, nominal.params)
     strengths = [{}] + [{n: v * f for n, v in strength.items()} for f in STRENGTH_FACTORS] if strength else [{}]
-    alternatives = [s for s in strengths if s] + list(effect.starts(scale))
+    shapes = list(effect.starts(scale))
+    alternatives = [s for s in strengths if s] + shapes
     for linear in linear_starts:
         lin_start, lin_bounds, _ = effect_start(system, effect, scale, nominal.params, linear)
         bounds = {n: (min(bounds[n][0], lin_bounds[n][0]), max(bounds[n][1], lin_bounds[n][1])) for n in bounds}
-        alternatives += [{**{n: lin_start[n] for n in system.linear}, **s} for s in strengths]
+        alternatives += [{**{n: lin_start[n] for n in system.linear}, **s} for s in strengths + shapes]
     for seed in seeds:  # clipped into the bounds by the unit scaling
         alternatives.append({n: seed[n] for n in start if n in seed})
     # the effect at zero is the calibrated nominal: the refit keeps it when it ends worse than that

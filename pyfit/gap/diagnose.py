@@ -377,9 +377,10 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     clock.end("where (nominal gap)")
     screening, fits, selected = {}, {}, None
     effects = cfg.effects or list(system.effects)
-    # nothing to attribute when the nominal model fits the held-out files within their noise, or fits none of
-    # its own calibration files
-    if gap["significant"] and report.best_calibration_nrmse(gap)[0] <= cfg.nominal_max_nrmse:
+    # nothing to attribute when the nominal model fits the held-out files within their noise. When it fits none
+    # of its own calibration files the effects are refitted all the same: a strong amplitude-dependent effect
+    # leaves no linear model fitting any level, and the verdict is "does not fit" only if no effect fits either
+    if gap["significant"]:
         screening_path = out / "fits" / "screening.json"
         stored = json.loads(screening_path.read_text()) if screening_path.is_file() else {}
         if stored.get("key") == key and "strengths" in stored:

@@ -75,6 +75,11 @@ def best_calibration_nrmse(gap: dict) -> tuple[float, str]:
     return (best["nrmse"], best["file"]) if best else (float("inf"), "")
 
 
+def best_refit(fits: dict) -> tuple[float, str]:
+    """The lowest calibration NRMSE of the models refitted with an effect, and that model ((inf, '') if none)."""
+    return min(((f.calibration_nrmse, name) for name, f in fits.items()), default=(float("inf"), ""))
+
+
 def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
              selected: str | None = None) -> dict:
     """The report: verdict, chosen effect, gap (where), ranking (which, how far), evidence. `selected`: the
@@ -113,7 +118,10 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
     ranking.sort(key=lambda d: (not d["kept"], not d["explains"], d["effect"] != selected, -d["score"]))
     best = ranking[0] if ranking else None
     best_cal, best_file = best_calibration_nrmse(gap)
-    nominal_fits = best_cal <= cfg.nominal_max_nrmse
+    # the model fits when the nominal fits some calibration file, or (a strong amplitude-dependent effect, which
+    # leaves no linear model fitting any level) a model with an effect fits the calibration files
+    refit_cal, refit_name = best_refit(fits)
+    nominal_fits = min(best_cal, refit_cal) <= cfg.nominal_max_nrmse
     if not nominal_fits:
         verdict, chosen = "nominal model does not fit", None
     elif not significant:
@@ -127,10 +135,16 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
     evidence = []
     if not nominal_fits:
         evidence = [f"the nominal model fits none of its calibration files: NRMSE {best_cal:.3f} on the best one "
-                    f"({best_file}; allowed: {cfg.nominal_max_nrmse}; 1.0 is the error of predicting zero): "
-                    "describe the system (--nominal FILE.toml) or check the channels and units",
+                    f"({best_file}; allowed: {cfg.nominal_max_nrmse}; 1.0 is the error of predicting zero), nor "
+                    "does any model with a candidate effect: describe the system (--nominal FILE.toml) or check "
+                    "the channels and units",
                     "nominal misfit by file: " + ", ".join(f"{d['file']}: {d['nrmse']:.3f}" for d in levels)]
-    elif significant and not chosen and best:
+    amplitude_note = []
+    if nominal_fits and best_cal > cfg.nominal_max_nrmse:
+        amplitude_note = [f"the nominal model fits none of its calibration files (NRMSE {best_cal:.3f} on the best "
+                          f"one) but the model with {refit_name} fits them at {refit_cal:.3f}: the response changes "
+                          "strongly with amplitude"]
+    if significant and nominal_fits and not chosen and best:
         evidence = [f"best candidate {best['effect']}: held-out NRMSE {best['heldout_gap_after']:.4f}, shrink "
                     f"{best['shrink_pct']:.1f} %; an explanation needs NRMSE <= {explained_below:.4f} (noise "
                     f"floor {floor:.4f}) and shrink >= {cfg.min_shrink_pct:.0f} %",
@@ -163,7 +177,9 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
             evidence.append("detection lines: odd misfit {:.2e} (noise {:.2e}), even misfit {:.2e} (noise {:.2e})"
                             .format(h["odd_detection"]["misfit"], h["odd_detection"]["noise"],
                                     h["even_detection"]["misfit"], h["even_detection"]["noise"]))
-    shape_starts = {name: [{p.name: p.range(scale)[1] for p in e.params if p.shape}] + list(e.starts(scale))
+    evidence = amplitude_note + evidence
+    shape_starts = {name: [d for d in [{p.name: p.range(scale)[1] for p in e.params if p.shape}] if d]
+                    + list(e.starts(scale))
                     for name, e in system.effects.items() if name in fits and e.starts(scale) and not e.members}
     return {"verdict": verdict, "chosen_effect": chosen, "significant": significant, "explained_below": explained_below,
             "shape_starts": shape_starts,
@@ -321,8 +337,8 @@ def markdown(result: dict) -> str:
                      f"{'—' if r['screening_explained'] is None else format(100 * r['screening_explained'], '.1f')} | "
                      f"{r['n_added_params']} | {params} |")
     for name, starts in result.get("shape_starts", {}).items():
-        lines += ["", f"{name}: the refit began from the best of these shapes on the calibration files, then fitted "
-                  "the shape: " + "; ".join(", ".join(f"{k} = {v:g}" for k, v in st.items()) for st in starts) + "."]
+        lines += ["", f"{name}: the refit began from the best of these starts (with the others above) on the "
+                  "calibration files, then fitted them: " + "; ".join(", ".join(f"{k} = {v:g}" for k, v in st.items()) for st in starts) + "."]
     if result["ranking"]:
         lines += ["", "Score = shrink − 5 points per added strength parameter beyond the first (shape parameters "
                   "are not charged). "

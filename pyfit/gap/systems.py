@@ -248,6 +248,18 @@ def sdof_loop_basin(values: dict) -> tuple:
     return round(values["nu"], 6), abs(values["gamma"]) + abs(values["delta"]) >= NARROW_FROM
 
 
+# Strengths of the cubic spring the refit starts from, as the share k3·σ_y²/k of the linear stiffness it adds at
+# the RMS deflection (either sign: hardening and softening), log-spaced over the two and a half decades below its
+# bound (0.3): a strong cubic spring under a sweep or stepped sine jumps between branches, and a least squares
+# started at zero stops at a fraction of it
+CUBIC_SHARES = (0.001, 0.003, 0.01, 0.03, 0.1)
+
+
+def _cubic_starts(*names):
+    """Scale -> the cubic strengths of CUBIC_SHARES, both signs, for each of the spring parameters `names`."""
+    return lambda s: [{n: sign * f * s.k / s.sigma_y**2 for n in names} for f in CUBIC_SHARES for sign in (1, -1)]
+
+
 # a lag of the output channels behind the inputs (unsynchronised DAQ modules, different anti-alias filters):
 # up to half a radian at the data's dominant frequency (sigma_y / sigma_v ~ 1/ω), either sign
 SENSOR_DELAY = Effect(
@@ -267,7 +279,7 @@ SDOF_EFFECTS = {
         shift_stiffness=0.1, starts=lambda s: _sdof_loop_starts(s)),
     "cubic_stiffness": Effect(
         "cubic_stiffness", (Param("k3", _sym(lambda s: 0.3 * s.k / s.sigma_y**2)),),
-        signature="resonance shift with amplitude squared, odd distortion"),
+        signature="resonance shift with amplitude squared, odd distortion", starts=_cubic_starts("k3")),
     "coulomb_friction": Effect(
         "coulomb_friction", (Param("F_c", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y)), _stick_velocity),
         signature="damping that falls with amplitude (largest misfit at the lowest level)"),
@@ -354,7 +366,7 @@ DAMPER_EFFECTS = {
         starts=lambda s: [dict(st) for st in DAMPER_LOOP_STARTS[1:]]),
     "cubic_stiffness": Effect(
         "cubic_stiffness", _pair("k_cs1", "k_cs2", _sym(lambda s: 0.3 * s.k / s.sigma_y**2)),
-        signature="resonance shifts with amplitude squared, odd distortion"),
+        signature="resonance shifts with amplitude squared, odd distortion", starts=_cubic_starts("k_cs1", "k_cs2")),
     "coulomb_friction": Effect(
         "coulomb_friction", _pair("F_c1", "F_c2", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y)) + (_stick_velocity,),
         signature="damping that falls with amplitude (largest misfit at the lowest level)"),
