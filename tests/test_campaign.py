@@ -98,5 +98,7 @@ def test_a_short_campaign_on_a_local_dask_cluster(tmp_path, fmu_dir, measured):
     assert summary["errors"] == 0
     again = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)  # resumes: nothing redone
     assert again["wall_s"] < 0.1 * summary["wall_s"]
+    assert summary["resumed"] == 0 and again["resumed"] == 20
+    assert "(20 read from an interrupted run)" in (tmp_path / "summary.md").read_text()
     assert json.loads((tmp_path / "summary.json").read_text())["cases"] == 20
     assert np.isfinite(summary["median_case_s"])

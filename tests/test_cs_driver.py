@@ -46,3 +46,15 @@ def test_a_diverging_run_fails_the_same_way_in_both_loops(runner, inputs, monkey
     assert "diverged" in compiled.message or "integration failed" in compiled.message
     assert np.all(np.isnan(compiled["y"]))
     assert fmu.simulate(t[-1], 1 / 750.0, ["y"], {"exc_type": 0}, inputs=u, input_time=t).ok  # usable again
+
+
+def test_a_run_past_its_wall_clock_limit_fails_the_same_way_in_both_loops(runner, inputs, monkeypatch):
+    """1500 communication points cannot be done within 1 µs: both loops stop at a check (every 16 points) with
+    the limit in the message, and the instance is usable again."""
+    t, u = inputs
+    fmu = runner("SDOFBoucWen")
+    compiled, python = _both(fmu, monkeypatch, stop_time=t[-1], output_interval=1 / 750.0, outputs=["y"],
+                             params={"exc_type": 0}, inputs=u, input_time=t, max_wall_s=1e-6)
+    for res in (compiled, python):
+        assert not res.ok and "longer than its limit of 1e-06 s" in res.message, res.message
+    assert fmu.simulate(t[-1], 1 / 750.0, ["y"], {"exc_type": 0}, inputs=u, input_time=t, max_wall_s=60.0).ok

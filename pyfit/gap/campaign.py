@@ -203,6 +203,8 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     jobs = [CaseJob(c, str(out), str(fmu_dir), record_s) for c in draw(n, seed, model)]
+    # cases an interrupted run finished: read, not diagnosed again, so this run's wall time does not cover them
+    resumed = sum((out / f"case{j.case.index:04d}" / "outcome.json").is_file() for j in jobs)
     t0 = time.perf_counter()
     if scheduler is None:
         from distributed import Client, LocalCluster
@@ -216,6 +218,7 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
         where = f"Dask scheduler {scheduler}"
     summary = summarise(outcomes)
     summary.update({"cases": n, "seed": seed, "record_s": record_s, "wall_s": time.perf_counter() - t0,
+                    "resumed": resumed,
                     "where": where, "command": command(n, seed, model), "model": model,
                     "stated_from": {k: stated_from[k] for k in ("source", "seed", "cases")} if stated_from else None})
     if calibrate:
@@ -261,7 +264,10 @@ def markdown(s: dict) -> str:
     """The campaign summary as Markdown."""
     system = {"sdof": "SDOF", "damper": "damper (random geometry)"}[s.get("model", "sdof")]
     lines = [f"{s['cases']} {system} cases (seed {s['seed']}, records {s['record_s']:g} s), {s['where']}: wall "
-             f"{s['wall_s'] / 60:.1f} min, median {s['median_case_s']:.0f} s per case (writing the files and "
+             f"{s['wall_s'] / 60:.1f} min"
+             + (f" for the {s['cases'] - s['resumed']} cases this run diagnosed ({s['resumed']} read from an "
+                "interrupted run)" if s.get("resumed") else "")
+             + f", median {s['median_case_s']:.0f} s per case (writing the files and "
              f"diagnosing); command: `{s['command']}`.", "",
              f"Top-1 accuracy on the {s['effect_cases']} cases with a withheld effect: {100 * s['top1']:.0f} %; "
              f"false alarms on the {s['null_cases']} null cases: {s['false_alarms']}; diagnoses that failed: "

@@ -103,6 +103,10 @@ def scaled(rec: Record, factor: float) -> Record:
 # relative error bound of the FMU's adaptive integrator in a diagnosis run: the outputs stay within 1e-4 of their
 # RMS of a 1e-10 run (test_records.py), a tenth or less of a record's sensor noise
 TOLERANCE = 1e-6
+# wall-clock limit of one simulation in a diagnosis [s]: a record simulates in well under a second to a few
+# seconds; a parameter set so stiff that the integrator crawls (a friction smoothed over a tiny velocity beside a
+# hard spring) counts as failed, as a diverging one does, instead of holding a fit for hours
+MAX_WALL_S = 60.0
 
 
 def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, lead_periods: int = 1,
@@ -118,7 +122,7 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
         repeat = rec.n // rec.samples_per_period
         inputs = {k: v.reshape(repeat, rec.samples_per_period).mean(axis=0) for k, v in rec.inputs.items()}
     res = drive(runner, inputs, rec.fs, list(outputs or rec.outputs), params, upsample, rec.samples_per_period,
-                max(lead_periods, 1) if rec.periodic else 0, tolerance)
+                max(lead_periods, 1) if rec.periodic else 0, tolerance, MAX_WALL_S)
     if not res.ok:
         return None
     return {k: without_offset(delayed(np.tile(v, repeat), rec.fs, delay, rec.periodic)[rec.first:])

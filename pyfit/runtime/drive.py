@@ -39,17 +39,19 @@ def fine_inputs(inputs: dict[str, np.ndarray], upsample: int, samples_per_period
 
 def drive(runner: FmuRunner, inputs: dict[str, np.ndarray], fs: float, outputs: list[str], params: dict,
           upsample: int = 4, samples_per_period: int | None = None, lead_periods: int = 0,
-          tolerance: float = 1e-8) -> SimulationResult:
+          tolerance: float = 1e-8, max_wall_s: float | None = None) -> SimulationResult:
     """Simulate the FMU driven by measured inputs (model variable -> samples at fs [Hz]).
 
     Returns the outputs at the record's own samples (t = 0, 1/fs, ...), as many as the inputs have; a run
-    that fails or returns a non-finite value gives ok=False with the reason (never an exception)."""
+    that fails, returns a non-finite value or takes longer than max_wall_s seconds gives ok=False with the
+    reason (never an exception)."""
     n = len(next(iter(inputs.values())))
     fine, skip = fine_inputs(inputs, upsample, samples_per_period, lead_periods)
     n_fine = len(next(iter(fine.values())))
     dt = 1.0 / (fs * upsample)
     t = np.arange(n_fine) * dt
-    res = runner.simulate(t[-1], dt, list(outputs), params, inputs=fine, input_time=t, tolerance=tolerance)
+    res = runner.simulate(t[-1], dt, list(outputs), params, inputs=fine, input_time=t, tolerance=tolerance,
+                          max_wall_s=max_wall_s)
     grid = np.arange(n) / fs
     if not res.ok:
         return SimulationResult(grid, {k: np.full(n, np.nan) for k in outputs}, False, res.message)

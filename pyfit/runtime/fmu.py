@@ -14,6 +14,7 @@ import ctypes
 import pathlib
 import shutil
 import threading
+import time as _time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,6 +34,10 @@ def load_fmu(cls, **kwargs):
     so two threads loading at once can leave the process in a folder that is deleted later."""
     with _LOADING:
         return cls(**kwargs)
+
+
+def _too_slow(max_wall_s: float, t: float) -> str:
+    return f"the simulation ran longer than its limit of {max_wall_s:g} s (wall clock), at t = {t:g} s"
 
 
 class ParameterError(ValueError):
@@ -177,13 +182,15 @@ class FmuRunner:
     def simulate(self, stop_time: float, output_interval: float, outputs: list[str],
                  params: dict | None = None, inputs: dict[str, np.ndarray] | None = None,
                  input_time: np.ndarray | None = None, tolerance: float = 1e-8,
-                 start_time: float = 0.0, hold_inputs: bool = False) -> SimulationResult:
+                 start_time: float = 0.0, hold_inputs: bool = False,
+                 max_wall_s: float | None = None) -> SimulationResult:
         """Simulate from start_time to stop_time; outputs sampled every output_interval (uniform grid).
 
         inputs: name -> samples at input_time (linear in between, sent with their slopes as input derivatives;
         hold_inputs=True holds each communication point's value over the step instead, as importers without
-        input derivatives do). A failing or diverging run returns
-        SimulationResult(ok=False) with the reason; invalid parameter names raise ParameterError.
+        input derivatives do). A failing or diverging run, or one still running after max_wall_s seconds (None:
+        no limit; a parameter set so stiff that the integrator crawls), returns SimulationResult(ok=False) with
+        the reason; invalid parameter names raise ParameterError.
         """
         params = dict(params or {})
         self.check_parameters(params)
@@ -202,9 +209,10 @@ class FmuRunner:
             self._state["log"].clear()
             fmu.reset()
             if self.interface == "CoSimulation":
-                vals = self._run_cs(fmu, time, outputs, params, inputs, input_time, tolerance, hold_inputs)
+                vals = self._run_cs(fmu, time, outputs, params, inputs, input_time, tolerance, hold_inputs,
+                                    max_wall_s)
             else:
-                vals = self._run_me(fmu, time, outputs, params, inputs, input_time, tolerance)
+                vals = self._run_me(fmu, time, outputs, params, inputs, input_time, tolerance, max_wall_s)
         except (FMICallException, OSError, RuntimeError) as exc:
             log = self._state.get("log", [])
             message = "; ".join(log[-2:] + [str(exc)]) if log else str(exc)
@@ -214,7 +222,8 @@ class FmuRunner:
         assert np.allclose(dt, output_interval, rtol=1e-9, atol=0), "output grid is not uniform"
         return SimulationResult(time, vals)
 
-    def _run_cs(self, fmu, time, outputs, params, inputs, input_time, tolerance, hold_inputs=False):
+    def _run_cs(self, fmu, time, outputs, params, inputs, input_time, tolerance, hold_inputs=False,
+                max_wall_s=None):
         fmu.setupExperiment(tolerance=tolerance, startTime=time[0])
         self.set_parameters(fmu, params)
         fmu.enterInitializationMode()
@@ -238,14 +247,17 @@ class FmuRunner:
         loop = cs_loop()
         if loop is not None:
             self._run_cs_compiled(loop, fmu, time, out_vr, result, in_vr if k else None,
-                                  u_at if k else None, None if (hold_inputs or not k) else slope)
+                                  u_at if k else None, None if (hold_inputs or not k) else slope, max_wall_s)
         else:  # the same loop in Python
             in_buf, der_buf = (ctypes.c_double * k)(), (ctypes.c_double * k)()
             order = (ctypes.c_int * k)(*([1] * k))
             get_real, do_step = fmu.fmi2GetReal, fmu.fmi2DoStep
             set_real, set_der = fmu.fmi2SetReal, fmu.fmi2SetRealInputDerivatives
             comp = fmu.component
+            t0 = _time.perf_counter()
             for i, t in enumerate(time):
+                if max_wall_s and i % 16 == 0 and _time.perf_counter() - t0 > max_wall_s:
+                    raise RuntimeError(_too_slow(max_wall_s, t))
                 if k:
                     in_buf[:] = u_at[:, i]
                     set_real(comp, in_vr, k, in_buf)
@@ -260,7 +272,7 @@ class FmuRunner:
         return {o: result[:, j].copy() for j, o in enumerate(outputs)}
 
     @staticmethod
-    def _run_cs_compiled(loop, fmu, time, out_vr, result, in_vr, u_at, slope):
+    def _run_cs_compiled(loop, fmu, time, out_vr, result, in_vr, u_at, slope, max_wall_s=None):
         """The communication loop of _run_cs in C (pyfit/runtime/cs_driver.c), through the FMU's own functions."""
         def fn(name):
             return ctypes.cast(getattr(fmu.dll, name), ctypes.c_void_p)
@@ -275,12 +287,14 @@ class FmuRunner:
         failed = loop(fmu.component, fn("fmi2SetReal"), fn("fmi2GetReal"), fn("fmi2SetRealInputDerivatives"),
                       fn("fmi2DoStep"), len(time), ptr(time), 0 if in_vr is None else len(in_vr),
                       in_vr, ptr(u_rows), ptr(s_rows), len(out_vr), out_vr, ptr(result),
-                      ctypes.byref(status), ctypes.byref(call))
+                      ctypes.byref(status), ctypes.byref(call), float(max_wall_s or 0.0))
+        if failed >= 0 and call.value == 5:
+            raise RuntimeError(_too_slow(max_wall_s, time[failed]))
         if failed >= 0:
             what = {1: "fmi2SetReal", 2: "fmi2GetReal", 3: "fmi2SetRealInputDerivatives", 4: "fmi2DoStep"}[call.value]
             raise RuntimeError(f"{what} returned status {status.value} at t = {time[failed]:g} s")
 
-    def _run_me(self, fmu, time, outputs, params, inputs, input_time, tolerance):
+    def _run_me(self, fmu, time, outputs, params, inputs, input_time, tolerance, max_wall_s=None):
         from fmpy import simulate_fmu
 
         sig = None
@@ -293,7 +307,10 @@ class FmuRunner:
         res = simulate_fmu(self.path, fmi_type="ModelExchange", fmu_instance=fmu,
                            model_description=self.model_description, start_time=time[0], stop_time=time[-1],
                            output_interval=time[1] - time[0], relative_tolerance=tolerance,
-                           start_values=params, input=sig, output=outputs, terminate=True, validate=False)
+                           start_values=params, input=sig, output=outputs, terminate=True, validate=False,
+                           timeout=max_wall_s)
         rt = res["time"]
+        if max_wall_s and rt[-1] < time[-1] - 1e-9 * max(1.0, abs(time[-1])):  # fmpy stops at its timeout
+            raise RuntimeError(_too_slow(max_wall_s, rt[-1]))
         # fmpy may add points at events; keep the uniform grid
         return {o: np.interp(time, rt, res[o]) for o in outputs}
