@@ -337,8 +337,9 @@ def markdown(result: dict) -> str:
                      f"{'—' if r['screening_explained'] is None else format(100 * r['screening_explained'], '.1f')} | "
                      f"{r['n_added_params']} | {params} |")
     for name, starts in result.get("shape_starts", {}).items():
-        lines += ["", f"{name}: the refit began from the best of these starts (with the others above) on the "
-                  "calibration files, then fitted them: " + "; ".join(", ".join(f"{k} = {v:g}" for k, v in st.items()) for st in starts) + "."]
+        listed = "; ".join(", ".join(f"{k} = {v:g}" for k, v in st.items()) for st in starts)
+        lines += ["", f"{name}: besides the screening's strengths, the refit began from the best of these starts on "
+                  f"the calibration files, then fitted every parameter: {listed}."]
     if result["ranking"]:
         lines += ["", "Score = shrink − 5 points per added strength parameter beyond the first (shape parameters "
                   "are not charged). "
