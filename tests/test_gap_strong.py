@@ -1,6 +1,7 @@
-"""Diagnosis where no linear model fits any level: a hardening spring so strong that the response jumps at every
-level, against records whose output has nothing to do with their input. Truths drawn at random, written by a
-generator independent of the FMUs (the CasADi reference integrated by CVODES). Slow: `pytest -m slow`."""
+"""Diagnosis where the nominal linear model fits no calibration file: a hardening spring (still refitted and
+named), against records whose output has nothing to do with their input (nothing fits: "nominal model does not
+fit"). Truths drawn at random, written by a generator independent of the FMUs (the CasADi reference integrated by
+CVODES). Slow: `pytest -m slow`."""
 import numpy as np
 import pytest
 
@@ -13,25 +14,26 @@ pytestmark = pytest.mark.slow
 SEED = 20261126
 
 
-def test_a_spring_so_hard_that_no_linear_model_fits_is_still_refitted_and_ranked_first(tmp_path, fmu_dir,
-                                                                                        measured):
-    """k3 drawn in 1.5e8-3e8 N/m³ on 6 s stepped sines (16 steps, 10/25/50 N): the response jumps between
-    branches at every level, and the nominal linear model, one compromise for every calibration level, fits none
-    of them (NRMSE above nominal_max_nrmse: asserted, so the draw tests what it says). The effects are refitted
-    all the same (before: "nominal model does not fit" and nothing refitted); the cubic spring, refitted from
-    the start of its log-spaced strengths that fits best, ranks first with most of the held-out gap removed."""
+def test_a_nominal_that_fits_no_calibration_file_still_has_its_effects_refitted(tmp_path, fmu_dir, measured):
+    """A hardening spring (k3 drawn in 1.5e8-3e8 N/m³) on 6 s stepped sines (16 steps, 10/25/50 N). A spring
+    hard enough that the response jumps at every level can leave the nominal linear model fitting none of the
+    calibration files (seen on a campaign case: NRMSE 1.0 on each); whether the least squares lands there on a
+    given draw is a matter of basins, so the test sets `nominal_max_nrmse` below the nominal's misfit (asserted)
+    instead. The effects are refitted all the same (before: "nominal model does not fit" and nothing refitted),
+    the report says that the response changes strongly with amplitude, and the cubic spring ranks first."""
     rng = np.random.default_rng(SEED)
     truth = {"k3": float(rng.uniform(1.5e8, 3e8))}
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "cubic_stiffness", seed=int(rng.integers(1e6)),
                                   truth=truth, style=datasets.LabStyle("stepped_sine", ("a",), record_s=6.0))
-    cfg = dg.DiagnoseConfig()
+    cfg = dg.DiagnoseConfig(nominal_max_nrmse=0.02)
     rep = dg.diagnose("sdof", data, tmp_path / "out", cfg, fmu_dir, workers=2, progress=False)
-    assert best_calibration_nrmse(rep["gap"])[0] > cfg.nominal_max_nrmse, "the draw is not strong enough"
+    assert best_calibration_nrmse(rep["gap"])[0] > cfg.nominal_max_nrmse
     assert rep["verdict"] != "nominal model does not fit", rep["evidence"]
+    assert "the response changes strongly with amplitude" in rep["evidence"][0]
     best = rep["ranking"][0]
     assert best["effect"] == "cubic_stiffness", (truth, rep["verdict"], [r["effect"] for r in rep["ranking"][:3]])
-    measured("SDOF hardening spring no linear model fits (stepped sines): held-out shrink of the cubic spring [%]",
-             best["shrink_pct"], 80.0, at_least=True)
+    measured("SDOF hardening spring on stepped sines, a nominal that fits no calibration file: held-out shrink of "
+             "the cubic spring [%]", best["shrink_pct"], 90.0, at_least=True)
 
 
 def test_records_whose_output_is_unrelated_to_the_input_do_not_fit(tmp_path, fmu_dir):
