@@ -178,11 +178,11 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
                             .format(h["odd_detection"]["misfit"], h["odd_detection"]["noise"],
                                     h["even_detection"]["misfit"], h["even_detection"]["noise"]))
     evidence = amplitude_note + evidence
-    shape_starts = {name: [d for d in [{p.name: p.range(scale)[1] for p in e.params if p.shape}] if d]
+    listed_starts = {name: [d for d in [{p.name: p.range(scale)[1] for p in e.params if p.shape}] if d]
                     + list(e.starts(scale))
                     for name, e in system.effects.items() if name in fits and e.starts(scale) and not e.members}
     return {"verdict": verdict, "chosen_effect": chosen, "significant": significant, "explained_below": explained_below,
-            "shape_starts": shape_starts,
+            "listed_starts": listed_starts,
             "runner_up_close": bool(close), "gap": gap, "ranking": ranking, "evidence": evidence,
             "nominal": {"params": _free_values(nominal), "calibration_nrmse": nominal.calibration_nrmse,
                         "evaluations": nominal.evaluations},
@@ -336,7 +336,7 @@ def markdown(result: dict) -> str:
         lines.append(f"| {r['effect']} | {r['score']:.1f} | {r['heldout_gap_after']:.4f} | {r['shrink_pct']:.1f} | "
                      f"{'—' if r['screening_explained'] is None else format(100 * r['screening_explained'], '.1f')} | "
                      f"{r['n_added_params']} | {params} |")
-    for name, starts in result.get("shape_starts", {}).items():
+    for name, starts in result.get("listed_starts", {}).items():
         listed = "; ".join(", ".join(f"{k} = {v:g}" for k, v in st.items()) for st in starts)
         lines += ["", f"{name}: besides the screening's strengths, the refit began from the best of these starts on "
                   f"the calibration files, then fitted every parameter: {listed}."]
