@@ -116,6 +116,30 @@ def test_sdof_coulomb_friction_and_cubic_stiffness_are_named_together(tmp_path, 
             assert r["calibration_nrmse"] <= max(calibration[m] for m in r["members"]) * (1 + 1e-12), r["effect"]
 
 
+@pytest.mark.xfail(strict=True, reason="known limitation: named cubic_stiffness + quadratic_damping (held-out "
+                   "0.0069 against a floor of 0.0036); the pair's joint refit ends at 0.0094 with the loop standing in "
+                   "for the spring, although from the withheld values it reaches 0.0038: no listed start leads there")
+def test_a_weak_loop_beside_a_strong_cubic_spring_is_named_as_both(tmp_path, fmu_dir, measured):
+    """A hardening spring beside a hysteretic element holding 2-5 % of the stiffness that turns over at 10-30 N,
+    its loop shape drawn at random, under band-limited noise recorded as displacement. A free-shape loop
+    refitted alone bends to stand in for the spring (its loop then holds most of the stiffness); the pair's
+    refit starts from the spring's refit with each of the loop's listed starts, which is not yet enough here."""
+    rng = np.random.default_rng(SEED + 4)
+    alpha = 1e5 * float(rng.uniform(0.02, 0.05))
+    nu = float(rng.uniform(1.2, 2.2))
+    truth = {**_loop(1e5 - alpha, nu, float(rng.uniform(0.1, 1.0)), float(rng.uniform(0.5, 2.5)),
+                     float(rng.uniform(10.0, 30.0))), "k3": float(rng.uniform(4e8, 7e8))}
+    assert _starts_hold_none_of({k: truth[k] for k in ("gamma", "delta", "nu")}, SDOF_EFFECTS["hysteresis"])
+    data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "cubic_stiffness+hysteresis", seed=56,
+                                  truth=truth, style=datasets.LabStyle("noise", ("y",), record_s=8.0))
+    rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
+    assert set((rep["chosen_effect"] or "").split(" + ")) == {"cubic_stiffness", "hysteresis"}, \
+        (truth, rep["verdict"], [(r["effect"], r["heldout_gap_after"]) for r in rep["ranking"][:4]])
+    best = rep["ranking"][0]
+    measured("SDOF with a weak loop beside a strong cubic spring: fitted k3 relative to the withheld value",
+             abs(best["params"]["k3"] / truth["k3"] - 1), 0.1)
+
+
 def test_a_weak_quadratic_damping_beside_a_strong_cubic_spring_is_named(tmp_path, fmu_dir, measured):
     """A hardening spring that jumps on a sweep and a quadratic damping far below 1 % of its candidate's range
     (the damping force a few % of the viscous one): the pair is named and c2 recovered."""

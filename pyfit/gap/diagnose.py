@@ -152,19 +152,30 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
     return None
 
 
-def _combination_seeds(system, current: dict, partner_fit: dict, partner: str, strength: dict) -> tuple[dict, ...]:
+def _combination_seeds(system, scale, current: dict, members: list, partner_fit: dict, partner: str,
+                       strength: dict) -> tuple[dict, ...]:
     """Starts of a combination's joint refit, each a model the combination holds: the model so far (`current`:
     its parameter values, the partner absent); the partner's own refit (the model so far's effects absent: a
     first effect that over-compensates for the second starts better at zero); the model so far with the
     partner's parameters from that refit, with the model so far's linear parameters or with the partner's (a
-    hysteretic element's refit moves the linear stiffness: its linear parameters belong with its loop); and the
-    model so far with the partner's strength from the Gauss-Newton step at that model (`strength`, screen's)
-    scaled by attribute.STRENGTH_FACTORS."""
+    hysteretic element's refit moves the linear stiffness: its linear parameters belong with its loop); the model
+    so far with the partner's strength from the Gauss-Newton step at that model (`strength`, screen's) scaled by
+    attribute.STRENGTH_FACTORS; the model so far with each listed start of the partner (effect.starts: loop
+    shapes, cubic strengths); and the partner's own refit with each listed start of the model so far's
+    `members` (a free-shape loop refitted alone bends into a strong element that stands in for a hardening
+    spring: the pair's basin is then the spring's refit with a weak loop of the family's shapes). A listed
+    start's linear values are shares of the nominal's, applied to the refit it is added to."""
     own = {p.name for p in system.effects[partner].params}
     linear = set(system.linear)
+
+    def added(base: dict, start: dict) -> dict:
+        return {**base, **{n: base[n] * v / scale.nominal[n] if n in linear else v for n, v in start.items()}}
+
     return ((current, partner_fit, {**current, **{n: partner_fit[n] for n in own}},
              {**current, **{n: v for n, v in partner_fit.items() if n in own or n in linear}})
-            + tuple({**current, **{n: v * f for n, v in strength.items()}} for f in STRENGTH_FACTORS if strength))
+            + tuple({**current, **{n: v * f for n, v in strength.items()}} for f in STRENGTH_FACTORS if strength)
+            + tuple(added(current, st) for st in system.effects[partner].starts(scale))
+            + tuple(added(partner_fit, st) for m in members for st in system.effects[m].starts(scale)))
 
 
 def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, scale, fits: dict, sims: dict, gap,
@@ -243,8 +254,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 fits[combo.name] = _stored(path, key)
                 names.append(combo.name)
                 if fits[combo.name] is None:
-                    seeds = _combination_seeds(system, fits[current].params, fits[partner].params, partner,
-                                               strength.get(partner, {}))
+                    seeds = _combination_seeds(system, scale, fits[current].params, members, fits[partner].params,
+                                               partner, strength.get(partner, {}))
                     task = effect_task(system, combo, fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
                                        seeds=seeds)
                     # never worse than the model it extends (the partner at zero is that model)
