@@ -179,8 +179,8 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
                                     h["even_detection"]["misfit"], h["even_detection"]["noise"]))
     evidence = amplitude_note + evidence
     listed_starts = {name: [d for d in [{p.name: p.range(scale)[1] for p in e.params if p.shape}] if d]
-                    + list(e.starts(scale))
-                    for name, e in system.effects.items() if name in fits and e.starts(scale) and not e.members}
+                     + list(e.starts(scale))
+                     for name, e in system.effects.items() if name in fits and e.starts(scale) and not e.members}
     return {"verdict": verdict, "chosen_effect": chosen, "significant": significant, "explained_below": explained_below,
             "listed_starts": listed_starts,
             "runner_up_close": bool(close), "gap": gap, "ranking": ranking, "evidence": evidence,
