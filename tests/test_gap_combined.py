@@ -116,14 +116,12 @@ def test_sdof_coulomb_friction_and_cubic_stiffness_are_named_together(tmp_path, 
             assert r["calibration_nrmse"] <= max(calibration[m] for m in r["members"]) * (1 + 1e-12), r["effect"]
 
 
-@pytest.mark.xfail(strict=True, reason="known limitation: named cubic_stiffness + quadratic_damping (held-out "
-                   "0.0069 against a floor of 0.0036); the pair's joint refit ends at 0.0094 with the loop standing in "
-                   "for the spring, although from the withheld values it reaches 0.0038: no listed start leads there")
 def test_a_weak_loop_beside_a_strong_cubic_spring_is_named_as_both(tmp_path, fmu_dir, measured):
     """A hardening spring beside a hysteretic element holding 2-5 % of the stiffness that turns over at 10-30 N,
     its loop shape drawn at random, under band-limited noise recorded as displacement. A free-shape loop
-    refitted alone bends to stand in for the spring (its loop then holds most of the stiffness); the pair's
-    refit starts from the spring's refit with each of the loop's listed starts, which is not yet enough here."""
+    refitted alone bends to stand in for the spring (its loop then holds most of the stiffness), and the pair's
+    joint descent from the same starts ends there too; the loop refitted first beside the spring's refit held
+    fixed finds the weak loop, and the joint refit goes on from it."""
     rng = np.random.default_rng(SEED + 4)
     alpha = 1e5 * float(rng.uniform(0.02, 0.05))
     nu = float(rng.uniform(1.2, 2.2))

@@ -21,7 +21,7 @@ from pyfit.runtime.examples import ensure_fmu
 from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read_toml
 from pyfit.gap import confidence, localise, selection, user_candidates
 from pyfit.gap import simulate as sim
-from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, nominal_task, run_fit, screen
+from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, nominal_task, pinned, run_fit, screen
 from pyfit.gap.systems import combine, family_fmu, make_system
 from pyfit.io.nominal import NominalModel, load_nominal
 
@@ -137,8 +137,13 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
 
 
 def _fit_and_store(job) -> Fit:
-    """Run one fit (in a worker) and store it at once, so an interrupted diagnosis keeps it."""
-    task, path, key = job
+    """Run one fit (in a worker) and store it at once, so an interrupted diagnosis keeps it. A job may carry a
+    first stage: a fit whose result the fit then also starts from."""
+    task, path, key, *stages = job
+    for stage in stages:
+        staged = run_fit(stage)
+        task = dataclasses.replace(task, alternatives=task.alternatives + (
+            {n: staged.params[n] for n in task.start},))
     fit = run_fit(task)
     pathlib.Path(path).write_text(json.dumps({"key": key, "fit": fit.to_json()}, indent=1))
     return fit
@@ -186,7 +191,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     whose sensitivity at that model explains most of its calibration residual (the screening repeated there;
     none when the model already meets the absolute criterion and no candidate explains
     `cfg.min_partner_explained` of that residual: the path and the search end there), refit jointly (from each
-    member's own refit and the effects' starts), and go on from the best combination when it removes
+    member's own refit and the effects' starts, and from each side refitted first beside the other held at its
+    own refit: attribute.pinned), and go on from the best combination when it removes
     `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted on with a
     combination's budget (the combinations start from that refit and never end worse than it) or, when lower, the
     misfit of the combination whose partner helped least (what the combination's extra evaluations alone buy the
@@ -262,8 +268,15 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                     added = {q.name for q in system.effects[partner].params}
                     at_zero = {**task.floor, **{n: v for n, v in fits[current].params.items()
                                                 if n in task.floor and n not in added}}
-                    jobs.append((dataclasses.replace(task, floor=at_zero, probes=cfg.combination_probes), str(path),
-                                 key))
+                    task = dataclasses.replace(task, floor=at_zero, probes=cfg.combination_probes)
+                    # first each side beside the other held at its own refit: the partner beside the model so far
+                    # (its members' own parameters fixed), and the members beside the partner's refit. A weak
+                    # effect beside a strong one is found there, where the joint descent from the same starts
+                    # lets the weak one take over the strong one's part
+                    held = {n: v for n, v in fits[current].params.items()
+                            if n in task.start and n not in added and n not in system.linear}
+                    jobs.append((task, str(path), key, pinned(task, held, cfg.refit_budget // 2),
+                                 pinned(task, {n: fits[partner].params[n] for n in added}, cfg.refit_budget // 2)))
             for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="combinations"):
                 fits[fit.effect] = fit
             for name in names:
