@@ -189,23 +189,26 @@ def by_loop_region(sim: dict, rec: Record) -> dict[str, float]:
 EXCITED_ENERGY = 0.998  # share of the input's spectral energy the excited range holds (non-periodic records)
 
 
-def excited_range(records: list[Record]) -> tuple[float, float]:
-    """Lowest and highest frequency [Hz] the records' inputs excite: the DFT lines above 1e-3 of the peak, and
+def excited_band(rec: Record) -> tuple[float, float]:
+    """Lowest and highest frequency [Hz] one record's input excites: the DFT lines above 1e-3 of the peak, and
     for a record that is not periodic (a sweep or noise, whose start and end leak energy to every line) the
     band that holds EXCITED_ENERGY of the input's energy."""
-    lo, hi = np.inf, 0.0
-    for rec in records:
-        u = rec.compared(next(iter(rec.inputs)))
-        U = np.abs(np.fft.rfft(u))
-        f = np.fft.rfftfreq(len(u), 1.0 / rec.fs)
-        on = (U > 1e-3 * U.max()) & (f > 0)
-        if not rec.periodic:
-            cum = np.cumsum(np.where(f > 0, U**2, 0.0))
-            tail = (1.0 - EXCITED_ENERGY) / 2 * cum[-1]
-            on &= (cum >= tail) & (cum <= cum[-1] - tail)
-        exc = f[on]
-        lo, hi = min(lo, exc.min()), max(hi, exc.max())
-    return float(lo), float(hi)
+    u = rec.compared(next(iter(rec.inputs)))
+    U = np.abs(np.fft.rfft(u))
+    f = np.fft.rfftfreq(len(u), 1.0 / rec.fs)
+    on = (U > 1e-3 * U.max()) & (f > 0)
+    if not rec.periodic:
+        cum = np.cumsum(np.where(f > 0, U**2, 0.0))
+        tail = (1.0 - EXCITED_ENERGY) / 2 * cum[-1]
+        on &= (cum >= tail) & (cum <= cum[-1] - tail)
+    exc = f[on]
+    return float(exc.min()), float(exc.max())
+
+
+def excited_range(records: list[Record]) -> tuple[float, float]:
+    """Lowest and highest frequency [Hz] the records' inputs excite (excited_band of each)."""
+    bands = [excited_band(rec) for rec in records]
+    return min(b[0] for b in bands), max(b[1] for b in bands)
 
 
 def default_bands(records: list[Record], n: int = 8) -> list[tuple[float, float]]:

@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.signal
 
+from pyfit.gap.localise import excited_band
+
 
 @dataclass(frozen=True)
 class Scale:
@@ -139,7 +141,9 @@ OUTPUT_ORDER = {"y": 0, "v": 1, "a": 2}  # SDOF outputs: displacement, velocity,
 def _frf_lines(rec, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(ω [rad/s], H of the displacement, weight) on the lines the input excites. Whole periods: the DFT lines
     (exact, no leakage). Otherwise the H1 estimate S_uy/S_uu from Welch segments (noise on the output averages
-    out), on the bins where the input has power and the coherence is above 0.5, weighted by the coherence."""
+    out), on the bins where the input has power, within the band that holds nearly all of its energy
+    (localise.excited_band: below it an accelerometer's slow drift, divided by ω², would pass for a huge
+    displacement FRF) and where the coherence is above 0.5, weighted by the coherence."""
     u, y = rec.compared(next(iter(rec.inputs))), rec.outputs[name]
     if rec.samples_per_period:
         U, Y = np.fft.rfft(u), np.fft.rfft(y)
@@ -152,7 +156,8 @@ def _frf_lines(rec, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         _, suy = scipy.signal.csd(u, y, rec.fs, nperseg=seg)
         _, coh = scipy.signal.coherence(u, y, rec.fs, nperseg=seg)
         w = 2 * np.pi * f
-        ex = (suu > 1e-3 * suu[1:].max()) & (w > 0) & (coh > 0.5)
+        lo, hi = excited_band(rec)
+        ex = (suu > 1e-3 * suu[1:].max()) & (f >= lo) & (f <= hi) & (coh > 0.5)
         H, weight = suy[ex] / suu[ex], coh[ex]
     return w[ex], H / (1j * w[ex]) ** OUTPUT_ORDER[name], weight
 
