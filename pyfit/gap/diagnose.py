@@ -137,8 +137,8 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
 
 
 def _fit_and_store(job) -> Fit:
-    """Run one fit (in a worker) and store it at once, so an interrupted diagnosis keeps it. A job may carry a
-    first stage: a fit whose result the fit then also starts from."""
+    """Run one fit (in a worker) and store it at once, so an interrupted diagnosis keeps it. A job may carry
+    stages: fits run first, whose results the fit then also starts from."""
     task, path, key, *stages = job
     for stage in stages:
         staged = run_fit(stage)
