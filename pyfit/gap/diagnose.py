@@ -138,13 +138,15 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
 
 def _fit_and_store(job) -> Fit:
     """Run one fit (in a worker) and store it at once, so an interrupted diagnosis keeps it. A job may carry
-    stages: fits run first, whose results the fit then also starts from."""
+    stages: fits run first, whose results the fit then also starts from (their evaluations and wall time are
+    counted in the fit's)."""
     task, path, key, *stages = job
-    for stage in stages:
-        staged = run_fit(stage)
-        task = dataclasses.replace(task, alternatives=task.alternatives + (
-            {n: staged.params[n] for n in task.start},))
-    fit = run_fit(task)
+    staged = [run_fit(stage) for stage in stages]
+    fit = run_fit(dataclasses.replace(task, alternatives=task.alternatives + tuple(
+        {n: s.params[n] for n in task.start} for s in staged)))
+    # the stages' cost is the fit's: its evaluations and wall time include theirs
+    fit = dataclasses.replace(fit, evaluations=fit.evaluations + sum(s.evaluations for s in staged),
+                              wall_s=fit.wall_s + sum(s.wall_s for s in staged))
     pathlib.Path(path).write_text(json.dumps({"key": key, "fit": fit.to_json()}, indent=1))
     return fit
 
