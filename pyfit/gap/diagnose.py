@@ -199,7 +199,9 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     combination's budget (the combinations start from that refit and never end worse than it) or, when lower, the
     misfit of the combination whose partner helped least (what the combination's extra evaluations alone buy the
     model it extends: selection.budget_control), up to `cfg.max_effects` members. Of the ends of these paths, a
-    larger model is selected only by the same rule (selection.simpler_or_better). Adds the fits and held-out
+    larger model is selected only by the same rule (selection.simpler_or_better). A path's end is then checked
+    backward: the model without its last-added member is refitted from the end's values, and the end is kept only
+    when it still removes `min_excess_cut` of what that refit leaves. Adds the fits and held-out
     simulations to `fits` and `sims`; returns the system with the combined effects among its effects and the model
     selected (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
@@ -292,7 +294,28 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                                                          cfg.min_excess_cut):
                 break
             current = best
-        return current
+        return pruned(current)
+
+    def pruned(end):
+        # the backward step: the model without its last-added member, refitted from the larger model's values
+        # with half a refit's budget (a loop refitted alone can stop in a basin whose misfit a stand-in partner
+        # then takes up; from the pair's loop it can go on to where the partner adds too little); the larger
+        # model stays only when it still adds enough to that refit
+        members = effects[end].members
+        rest = named.get(frozenset(members[:-1])) if members else None
+        if rest is None:
+            return end
+        path = out / "fits" / f"{end.replace(' + ', '+')}.reduced.json"
+        task = effect_task(system, effects[rest], fmu, cal, nominal, scale, cfg.refit_budget // 2, cfg.upsample,
+                           seeds=(fits[end].params,))
+        reduced = _stored(path, key) or _fit_and_store((dataclasses.replace(
+            task, start=task.alternatives[-1], alternatives=(), basin=None, threads=workers or os.cpu_count() or 1),
+            str(path), key))
+        if reduced.calibration_nrmse < fits[rest].calibration_nrmse:
+            fits[rest] = reduced
+            simulated(rest)
+        return end if selection.adds_enough(min(after[rest], controls.get(end, float("inf"))), after[end], floor,
+                                            cfg.min_excess_cut) else rest
 
     def kept(a, b):  # of two path ends, the one a path would keep (selection.simpler_or_better)
         sized = [(len(effects[n].members or (n,)), after[n]) for n in (a, b)]
