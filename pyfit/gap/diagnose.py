@@ -207,6 +207,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     before, floor = gap["overall"], gap["noise_floor"]
     explained_below = selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin)
     settled = set()  # models that meet the absolute criterion and leave nothing a candidate's sensitivity explains
+    alone = workers or os.cpu_count() or 1  # a fit that runs alone simulates its records at once
 
     def left(name):  # a model's held-out misfit is above the noise (a weaker test than the nominal's): go on adding
         return selection.significant(after[name], floor, cfg.noise_factor, cfg.combination_min_gap)
@@ -237,8 +238,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             again_path = out / "fits" / f"{current.replace(' + ', '+')}.continued.json"
             again = _stored(again_path, key) or _fit_and_store((dataclasses.replace(
                 effect_task(system, effects[current], fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
-                            seeds=(fits[current].params,)), threads=workers or os.cpu_count() or 1),
-                str(again_path), key))  # it runs alone: its records are simulated at once
+                            seeds=(fits[current].params,)), threads=alone), str(again_path), key))
             if again.calibration_nrmse < fits[current].calibration_nrmse:
                 fits[current] = again
                 simulated(current)
@@ -309,8 +309,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         task = effect_task(system, effects[rest], fmu, cal, nominal, scale, cfg.refit_budget // 2, cfg.upsample,
                            seeds=(fits[end].params,))
         reduced = _stored(path, key) or _fit_and_store((dataclasses.replace(
-            task, start=task.alternatives[-1], alternatives=(), basin=None, threads=workers or os.cpu_count() or 1),
-            str(path), key))
+            task, start=task.alternatives[-1], alternatives=(), basin=None, threads=alone), str(path), key))
         if reduced.calibration_nrmse < fits[rest].calibration_nrmse:
             fits[rest] = reduced
             simulated(rest)
