@@ -92,14 +92,16 @@ def test_close_runner_up_gets_a_level_and_band_to_measure(data_root, fmu_dir):
 
 def test_a_pinned_refit_holds_the_given_values_and_tries_each_remaining_start_once():
     """attribute.pinned: the held parameters leave the fitted set (start, bounds, log scaling, every start)
-    for the fixed ones; starts that differed only in them are tried once."""
+    for the fixed ones; starts that differed only in them are tried once; it descends from the best of them
+    only (the joint refit it seeds probes)."""
     from pyfit.gap.attribute import FitTask, pinned
 
     task = FitTask("x.fmu", (), {"m": 2.0}, {"k": 1e5, "k3": 0.0, "c2": 0.0},
                    {"k": (5e4, 2e5), "k3": (-1e9, 1e9), "c2": (1e-3, 10.0)}, "cubic_stiffness + quadratic_damping",
                    2, 120, 1, alternatives=({"k3": 1e8}, {"k3": -1e8}, {"k3": 1e8, "c2": 2.0}),
-                   log_scaled=("c2", "k3"))
+                   log_scaled=("c2", "k3"), probes=3)
     held = pinned(task, {"k3": 5e8}, 60)
+    assert held.probes == 1 and task.probes == 3
     assert held.fixed == {"m": 2.0, "k3": 5e8}
     assert held.start == {"k": 1e5, "c2": 0.0} and set(held.bounds) == {"k", "c2"}
     assert held.alternatives == ({}, {"c2": 2.0}) and held.log_scaled == ("c2",) and held.budget == 60

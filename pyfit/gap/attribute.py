@@ -194,14 +194,15 @@ def run_fit(task: FitTask) -> Fit:
 
 def pinned(task: FitTask, values: dict, budget: int) -> FitTask:
     """`task` with the parameters of `values` held at those values (no longer fitted), its starts that then
-    coincide taken once, and `budget` evaluations: e.g. an effect refitted beside the model it extends held at
-    that model's refit, before the two are refitted together."""
+    coincide taken once, and `budget` evaluations from the best of them only (no probes): e.g. an effect refitted
+    beside the model it extends held at that model's refit, before the two are refitted together (that joint
+    refit then probes from the best starts, this result among them)."""
     free = {n: v for n, v in task.start.items() if n not in values}
     alternatives = {tuple(sorted(a.items())): a for a in
                     ({n: v for n, v in alt.items() if n not in values} for alt in task.alternatives)}
     return dataclasses.replace(task, fixed={**task.fixed, **values}, start=free,
                                bounds={n: task.bounds[n] for n in free}, alternatives=tuple(alternatives.values()),
-                               log_scaled=tuple(n for n in task.log_scaled if n in free), budget=budget)
+                               log_scaled=tuple(n for n in task.log_scaled if n in free), budget=budget, probes=1)
 
 
 STIFFNESS_SCAN = (0.25, 0.5, 1.0, 2.0, 4.0)  # factors on the nominal stiffness tried before the least squares

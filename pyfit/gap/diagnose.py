@@ -159,6 +159,11 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
     return None
 
 
+def _stem(name: str) -> str:
+    """The file stem a model's fit is stored under (a combination 'a + b' as 'a+b')."""
+    return name.replace(" + ", "+")
+
+
 def _combination_seeds(system, scale, current: dict, members: list, partner_fit: dict, partner: str,
                        strength: dict) -> tuple[dict, ...]:
     """Starts of a combination's joint refit, each a model the combination holds: the model so far (`current`:
@@ -235,7 +240,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             # the model so far, refitted on from its own result with a combination's budget: a combination must
             # beat more evaluations of its first member(s), not only the first refit; the partners then start from
             # (and never end worse than) the model so far at its best
-            again_path = out / "fits" / f"{current.replace(' + ', '+')}.continued.json"
+            again_path = out / "fits" / f"{_stem(current)}.continued.json"
             again = _stored(again_path, key) or _fit_and_store((dataclasses.replace(
                 effect_task(system, effects[current], fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
                             seeds=(fits[current].params,)), threads=alone), str(again_path), key))
@@ -260,7 +265,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                     continue
                 combo = combine([system.effects[m] for m in members + [partner]])
                 effects[combo.name], named[together] = combo, combo.name
-                path = out / "fits" / f"{combo.name.replace(' + ', '+')}.json"
+                path = out / "fits" / f"{_stem(combo.name)}.json"
                 fits[combo.name] = _stored(path, key)
                 names.append(combo.name)
                 if fits[combo.name] is None:
@@ -277,10 +282,16 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                     # (its members' own parameters fixed), and the members beside the partner's refit. A weak
                     # effect beside a strong one is found there, where the joint descent from the same starts
                     # lets the weak one take over the strong one's part
-                    held = {n: v for n, v in fits[current].params.items()
-                            if n in task.start and n not in added and n not in system.linear}
-                    jobs.append((task, str(path), key, pinned(task, held, cfg.refit_budget // 2),
-                                 pinned(task, {n: fits[partner].params[n] for n in added}, cfg.refit_budget // 2)))
+                    so_far = {n: v for n, v in fits[current].params.items()
+                              if n in task.start and n not in added and n not in system.linear}
+                    jobs.append((task, str(path), so_far, {n: fits[partner].params[n] for n in added}))
+            threads = max(1, alone // max(1, len(jobs)))  # fewer jobs than workers: records at once
+
+            def job(task, path, *sides):  # the joint refit and its two held stages (attribute.pinned)
+                task = dataclasses.replace(task, threads=threads)
+                return (task, path, key, *(pinned(task, side, cfg.refit_budget // 2) for side in sides))
+
+            jobs = [job(*j) for j in jobs]
             for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="combinations"):
                 fits[fit.effect] = fit
             for name in names:
@@ -296,6 +307,18 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             current = best
         return pruned(current)
 
+    def onward(name, values, budget, stored_as):
+        # the model `name` refitted from `values` only, with `budget` evaluations on every core, stored as
+        # fits/<stored_as>.json; it replaces the model's fit when its calibration misfit is lower
+        path = out / "fits" / f"{stored_as}.json"
+        task = effect_task(system, effects[name], fmu, cal, nominal, scale, budget, cfg.upsample, seeds=(values,))
+        fit = _stored(path, key) or _fit_and_store((dataclasses.replace(
+            task, start=task.alternatives[-1], alternatives=(), basin=None, threads=alone), str(path), key))
+        if fit.calibration_nrmse < fits[name].calibration_nrmse:  # its cost includes the fit it goes on from
+            fits[name] = dataclasses.replace(fit, evaluations=fit.evaluations + fits[name].evaluations,
+                                             wall_s=fit.wall_s + fits[name].wall_s)
+            simulated(name)
+
     def pruned(end):
         # the backward step: the model without its last-added member, refitted from the larger model's values
         # with half a refit's budget (a loop refitted alone can stop in a basin whose misfit a stand-in partner
@@ -305,14 +328,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         rest = named.get(frozenset(members[:-1])) if members else None
         if rest is None:
             return end
-        path = out / "fits" / f"{end.replace(' + ', '+')}.reduced.json"
-        task = effect_task(system, effects[rest], fmu, cal, nominal, scale, cfg.refit_budget // 2, cfg.upsample,
-                           seeds=(fits[end].params,))
-        reduced = _stored(path, key) or _fit_and_store((dataclasses.replace(
-            task, start=task.alternatives[-1], alternatives=(), basin=None, threads=alone), str(path), key))
-        if reduced.calibration_nrmse < fits[rest].calibration_nrmse:
-            fits[rest] = reduced
-            simulated(rest)
+        onward(rest, fits[end].params, cfg.refit_budget // 2, f"{_stem(end)}.reduced")
         return end if selection.adds_enough(min(after[rest], controls.get(end, float("inf"))), after[end], floor,
                                             cfg.min_excess_cut) else rest
 
@@ -327,7 +343,13 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         ends.append(grow(start))
         if not left(ends[-1]) or ends[-1] in settled:
             break  # a path that reaches the noise, or explains the data with nothing a candidate explains left
-    return dataclasses.replace(system, effects=effects), functools.reduce(kept, ends)
+    selected = functools.reduce(kept, ends)
+    if after[selected] > explained_below:
+        # the selected model refitted on from its own values with twice a refit's budget before it is judged
+        # against the absolute criterion (which model is selected is settled; a joint refit of many parameters
+        # can stop short of the floor its effects reach)
+        onward(selected, fits[selected].params, 2 * cfg.refit_budget, f"{_stem(selected)}.polished")
+    return dataclasses.replace(system, effects=effects), selected
 
 
 def fmu_defaults(runner: FmuRunner) -> dict[str, float]:
