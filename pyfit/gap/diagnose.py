@@ -159,6 +159,20 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
     return None
 
 
+def _fits_of(jobs, key: str, alone: int, workers, progress: bool, desc: str) -> dict[str, Fit]:
+    """The fits of `jobs` ((task, path, *stages): see _fit_and_store) by their effect's name: each stored one read
+    from its path, the others run (in workers), each simulating its records on alone // (fits run) threads when
+    fewer fits than cores run."""
+    done = {job[0].effect: _stored(pathlib.Path(job[1]), key) for job in jobs}
+    todo = [job for job in jobs if done[job[0].effect] is None]
+    threads = max(1, alone // max(1, len(todo)))
+    todo = [(dataclasses.replace(task, threads=threads), str(path), key,
+             *(dataclasses.replace(stage, threads=threads) for stage in stages)) for task, path, *stages in todo]
+    for fit in map_tasks(_fit_and_store, todo, workers=workers, progress=progress, desc=desc):
+        done[fit.effect] = fit
+    return done
+
+
 def _stem(name: str) -> str:
     """The file stem a model's fit is stored under (a combination 'a + b' as 'a+b')."""
     return name.replace(" + ", "+")
@@ -197,18 +211,21 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     can lead, the true first member come second): extend the model by each of the `cfg.partners` other effects
     whose sensitivity at that model explains most of its calibration residual (the screening repeated there;
     none when the model already meets the absolute criterion and no candidate explains
-    `cfg.min_partner_explained` of that residual: the path and the search end there), refit jointly (from each
-    member's own refit and the effects' starts, and from each side refitted first beside the other held at its
-    own refit: attribute.pinned), and go on from the best combination when it removes
-    `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted on with a
-    combination's budget (the combinations start from that refit and never end worse than it) or, when lower, the
-    misfit of the combination whose partner helped least (what the combination's extra evaluations alone buy the
-    model it extends: selection.budget_control), up to `cfg.max_effects` members. Of the ends of these paths, a
-    larger model is selected only by the same rule (selection.simpler_or_better). A path's end is then checked
-    backward: the model without its last-added member is refitted from the end's values, and the end is kept only
-    when it still removes `min_excess_cut` of what that refit leaves. Adds the fits and held-out
-    simulations to `fits` and `sims`; returns the system with the combined effects among its effects and the model
-    selected (None when nothing was tried)."""
+    `cfg.min_partner_explained` of that residual: the path and the search end there). Each partner is refitted
+    beside the model so far held at its own refit (attribute.pinned); the one that helps most there, and the one
+    that helps least (the control), are then refitted jointly (from each member's own refit, the effects' starts,
+    the partner's refit beside the model and the members refitted beside the partner's refit). Go on from the
+    best combination when it removes `min_excess_cut` of the misfit above the floor that the model it extends
+    leaves once refitted on with a combination's budget (the combinations start from that refit and never end
+    worse than it) or, when lower, the misfit of the control's joint refit (what the combination's extra
+    evaluations alone buy the model it extends: selection.budget_control), up to `cfg.max_effects` members.
+    A path's end is checked backward: the model without its last-added member is refitted from the end's
+    values, and the end is kept only when it still removes `min_excess_cut` of what that refit leaves; an end
+    still above the absolute criterion is then refitted on from its own values. A path whose start is a member
+    of an earlier path's end that explains the data is not tried. Of the ends of these paths, a larger model is
+    selected only by the same rule (selection.simpler_or_better). Adds the fits and held-out simulations to
+    `fits` and `sims`; returns the system with the combined effects among its effects and the model selected
+    (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
     explained_below = selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin)
     settled = set()  # models that meet the absolute criterion and leave nothing a candidate's sensitivity explains
@@ -249,7 +266,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 simulated(current)
             if not left(current):
                 break  # the model so far, refitted on, reaches the noise: nothing left to add
-            jobs, names = [], []
+            names, new = [], []
             # the next member: the candidates whose sensitivity at the model so far explains most of its
             # residual on the calibration files (the screening's score test, repeated at that model)
             others = [n for n in system.effects if n not in members and n in fits]
@@ -265,42 +282,49 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                     continue
                 combo = combine([system.effects[m] for m in members + [partner]])
                 effects[combo.name], named[together] = combo, combo.name
-                path = out / "fits" / f"{_stem(combo.name)}.json"
-                fits[combo.name] = _stored(path, key)
                 names.append(combo.name)
-                if fits[combo.name] is None:
-                    seeds = _combination_seeds(system, scale, fits[current].params, members, fits[partner].params,
-                                               partner, strength.get(partner, {}))
-                    task = effect_task(system, combo, fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
-                                       seeds=seeds)
-                    # never worse than the model it extends (the partner at zero is that model)
-                    added = {q.name for q in system.effects[partner].params}
-                    at_zero = {**task.floor, **{n: v for n, v in fits[current].params.items()
-                                                if n in task.floor and n not in added}}
-                    task = dataclasses.replace(task, floor=at_zero, probes=cfg.combination_probes)
-                    # first each side beside the other held at its own refit: the partner beside the model so far
-                    # (its members' own parameters fixed), and the members beside the partner's refit. A weak
-                    # effect beside a strong one is found there, where the joint descent from the same starts
-                    # lets the weak one take over the strong one's part
-                    so_far = {n: v for n, v in fits[current].params.items()
-                              if n in task.start and n not in added and n not in system.linear}
-                    jobs.append((task, str(path), so_far, {n: fits[partner].params[n] for n in added}))
-            threads = max(1, alone // max(1, len(jobs)))  # fewer jobs than workers: records at once
-
-            def job(task, path, *sides):  # the joint refit and its two held stages (attribute.pinned)
-                task = dataclasses.replace(task, threads=threads)
-                return (task, path, key, *(pinned(task, side, cfg.refit_budget // 2) for side in sides))
-
-            jobs = [job(*j) for j in jobs]
-            for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="combinations"):
-                fits[fit.effect] = fit
+                seeds = _combination_seeds(system, scale, fits[current].params, members, fits[partner].params,
+                                           partner, strength.get(partner, {}))
+                task = effect_task(system, combo, fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
+                                   seeds=seeds)
+                # never worse than the model it extends (the partner at zero is that model)
+                added = {q.name for q in system.effects[partner].params}
+                at_zero = {**task.floor, **{n: v for n, v in fits[current].params.items()
+                                            if n in task.floor and n not in added}}
+                task = dataclasses.replace(task, floor=at_zero, probes=cfg.combination_probes)
+                # each side refitted beside the other held at its own refit (attribute.pinned): the partner
+                # beside the model so far (its members' own parameters fixed), and the members beside the
+                # partner's refit. A weak effect beside a strong one is found there, where the joint descent
+                # from the same starts lets the weak one take over the strong one's part
+                so_far = {n: v for n, v in fits[current].params.items()
+                          if n in task.start and n not in added and n not in system.linear}
+                new.append((combo.name, task, so_far, {n: fits[partner].params[n] for n in added}))
+            # every partner first beside the model so far held (half a refit's budget, no probes); the joint
+            # refit then only for the partner that helps most there and, as the control, the one that helps least
+            beside = _fits_of([(pinned(task, so_far, cfg.refit_budget // 2), out / "fits" / f"{_stem(n)}.beside.json")
+                               for n, task, so_far, _ in new], key, alone, workers, progress, "partners beside")
+            # (by the calibration misfit the refits beside minimised: a hardening spring held at its own refit
+            # can jump on a held-out sweep where the partner's refit beside it does not tell that partner apart)
+            order = sorted(beside, key=lambda n: beside[n].calibration_nrmse)
+            joint = {order[0], order[-1]} if len(names) >= selection.CONTROL_SIBLINGS else set(order[:1])
+            for name in set(beside) - joint:  # its fit is the one beside the model so far
+                fits[name] = beside[name]
+            jointly = _fits_of([(dataclasses.replace(task, alternatives=task.alternatives + (
+                {n: beside[name].params[n] for n in task.start},)), out / "fits" / f"{_stem(name)}.json",
+                pinned(task, side, cfg.refit_budget // 2)) for name, task, _, side in new if name in joint],
+                key, alone, workers, progress, "combinations")
+            for name, fit in jointly.items():  # its cost includes the refit beside the model so far
+                fits[name] = dataclasses.replace(fit, evaluations=fit.evaluations + beside[name].evaluations,
+                                                 wall_s=fit.wall_s + beside[name].wall_s)
             for name in names:
                 if name not in after or name not in sims:
                     simulated(name)
-            control = selection.budget_control([after[n] for n in names])
+            best = min(names, key=lambda n: after[n], default=None)
+            least = order[-1] if order else max(names, key=lambda n: after[n], default=None)
+            control = selection.budget_control(after[least], len(names)) if least not in (None, best) \
+                else float("inf")
             for name in names:  # the lowest control any of its refits met
                 controls[name] = min(controls.get(name, float("inf")), control)
-            best = min(names, key=lambda n: after[n], default=None)
             if best is None or not selection.adds_enough(min(after[current], controls[best]), after[best], floor,
                                                          cfg.min_excess_cut):
                 break
@@ -338,17 +362,22 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         return (a, b)[selection.simpler_or_better(*sized, floor, cfg.min_excess_cut,
                                                   controls.get(larger, float("inf")))]
 
+    def polished(end):
+        # a path's end still above the absolute criterion, refitted on from its own values with twice a refit's
+        # budget before it is judged (which model the path ends at is settled; a joint refit of many parameters
+        # can stop short of the floor its effects reach)
+        if after[end] > explained_below:
+            onward(end, fits[end].params, 2 * cfg.refit_budget, f"{_stem(end)}.polished")
+        return end
+
     ends = []
     for start in ranked[:cfg.beam]:
-        ends.append(grow(start))
+        if any(after[e] <= explained_below and start in (effects[e].members or (e,)) for e in ends):
+            break  # an earlier path's end explains the data and holds this start already
+        ends.append(polished(grow(start)))
         if not left(ends[-1]) or ends[-1] in settled:
             break  # a path that reaches the noise, or explains the data with nothing a candidate explains left
     selected = functools.reduce(kept, ends)
-    if after[selected] > explained_below:
-        # the selected model refitted on from its own values with twice a refit's budget before it is judged
-        # against the absolute criterion (which model is selected is settled; a joint refit of many parameters
-        # can stop short of the floor its effects reach)
-        onward(selected, fits[selected].params, 2 * cfg.refit_budget, f"{_stem(selected)}.polished")
     return dataclasses.replace(system, effects=effects), selected
 
 

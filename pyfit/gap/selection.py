@@ -52,12 +52,12 @@ def nothing_to_add(nrmse: float, explained_below: float, partner_explained: list
     return nrmse <= explained_below and max(partner_explained, default=0.0) < min_partner_explained
 
 
-def budget_control(sibling_nrmse: list[float], min_siblings: int = CONTROL_SIBLINGS) -> float:
-    """What more refit evaluations alone buy a model being extended: the held-out NRMSE of its extension whose
-    added effect helped least (of `min_siblings` or more extensions refitted alike from the same model, the worst
-    one's added effect explains ~nothing, so its gain is the model's own parameters refitted on). inf when fewer
-    extensions were tried (no control)."""
-    return max(sibling_nrmse) if len(sibling_nrmse) >= min_siblings else float("inf")
+def budget_control(least_helpful_nrmse: float, siblings: int, min_siblings: int = CONTROL_SIBLINGS) -> float:
+    """What more refit evaluations alone buy a model being extended: the held-out NRMSE of the joint refit of its
+    extension whose added effect helped least (of `min_siblings` or more extensions tried from the same model,
+    the least helpful one's added effect explains ~nothing, so its gain is the model's own parameters refitted
+    on). inf when fewer extensions were tried (no control)."""
+    return least_helpful_nrmse if siblings >= min_siblings else float("inf")
 
 
 def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, min_excess_cut: float,
