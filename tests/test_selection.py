@@ -27,6 +27,9 @@ def test_a_larger_model_is_kept_only_when_it_removes_half_the_misfit_left_above_
     # exactly half is enough; of two as large, the lower misfit
     assert selection.adds_enough(0.0207, floor + 0.5 * (0.0207 - floor), floor, cut)
     assert selection.simpler_or_better((2, 0.0060), (2, 0.0054), floor, cut) == 1
+    # a smaller model that leaves nothing above the floor cannot be improved on (the larger's lower misfit is noise)
+    assert not selection.adds_enough(0.0050, 0.0045, 0.0052, cut)
+    assert selection.simpler_or_better((1, 0.0050), (2, 0.0045), 0.0052, cut) == 0
 
 
 def test_a_model_is_extended_only_while_its_misfit_is_a_significant_gap():

@@ -219,6 +219,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     leaves once refitted on with a combination's budget (the combinations start from that refit and never end
     worse than it) or, when lower, the misfit of the control's joint refit (what the combination's extra
     evaluations alone buy the model it extends: selection.budget_control), up to `cfg.max_effects` members.
+    The noise these tests measure a misfit above is the floor should the sensor noise grow with the level
+    (gap["noise_floor_scaled"]): a floor taken too low asks a right pair to remove half of a misfit that is noise.
     A path's end is checked backward: the model without its last-added member is refitted from the end's
     values, and the end is kept only when it still removes `min_excess_cut` of what that refit leaves; an end
     still above the absolute criterion is then refitted on from its own values. A path whose start is a member
@@ -227,12 +229,13 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     `fits` and `sims`; returns the system with the combined effects among its effects and the model selected
     (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
+    above = gap["noise_floor_scaled"]  # the noise the selection measures a misfit above (at least the floor)
     explained_below = selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin)
     settled = set()  # models that meet the absolute criterion and leave nothing a candidate's sensitivity explains
     alone = workers or os.cpu_count() or 1  # a fit that runs alone simulates its records at once
 
     def left(name):  # a model's held-out misfit is above the noise (a weaker test than the nominal's): go on adding
-        return selection.significant(after[name], floor, cfg.noise_factor, cfg.combination_min_gap)
+        return selection.significant(after[name], above, cfg.noise_factor, cfg.combination_min_gap)
 
     after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
 
@@ -325,7 +328,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 else float("inf")
             for name in names:  # the lowest control any of its refits met
                 controls[name] = min(controls.get(name, float("inf")), control)
-            if best is None or not selection.adds_enough(min(after[current], controls[best]), after[best], floor,
+            if best is None or not selection.adds_enough(min(after[current], controls[best]), after[best], above,
                                                          cfg.min_excess_cut):
                 break
             current = best
@@ -353,13 +356,13 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         if rest is None:
             return end
         onward(rest, fits[end].params, cfg.refit_budget // 2, f"{_stem(end)}.reduced")
-        return end if selection.adds_enough(min(after[rest], controls.get(end, float("inf"))), after[end], floor,
+        return end if selection.adds_enough(min(after[rest], controls.get(end, float("inf"))), after[end], above,
                                             cfg.min_excess_cut) else rest
 
     def kept(a, b):  # of two path ends, the one a path would keep (selection.simpler_or_better)
         sized = [(len(effects[n].members or (n,)), after[n]) for n in (a, b)]
         larger = (a, b)[sized[1][0] > sized[0][0]]
-        return (a, b)[selection.simpler_or_better(*sized, floor, cfg.min_excess_cut,
+        return (a, b)[selection.simpler_or_better(*sized, above, cfg.min_excess_cut,
                                                   controls.get(larger, float("inf")))]
 
     def polished(end):

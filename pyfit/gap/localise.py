@@ -98,20 +98,25 @@ def local_polynomial_noise(u: np.ndarray, y: np.ndarray, degree: int = 2, half_w
 UPPER_BOUNDS = ("unexcited lines", "quiet band", "local polynomial")  # methods that count distortion as noise too
 
 
-def noise_estimates(records: list[Record]) -> dict[str, tuple[float, str]]:
+def noise_estimates(records: list[Record], level_scaled: bool = False) -> dict[str, tuple[float, str]]:
     """Each record's noise floor as an NRMSE (over its output channels) and the method used (see
     _noise_variance); never below the writer's rounding, so never zero.
 
     Where a method is an upper bound that also counts nonlinear distortion (UPPER_BOUNDS), a channel's noise
     variance is the smallest that method gives over the dataset's records: sensor noise does not grow with
     the excitation level, distortion does, so the lowest level bounds the noise of all (method marked
-    'lowest level')."""
+    'lowest level').
+
+    level_scaled: the estimate for sensor noise that may instead grow in proportion to the level (a data
+    acquisition whose input range is set per level): the larger of that bound and the lowest level's noise
+    relative to its own power, times the record's power (each at most the record's own estimate)."""
     per = {r.name: {k: _noise_variance(r, y) for k, y in r.outputs.items()} for r in records}
-    lowest = {}
+    lowest, lowest_relative = {}, {}
     for r in records:
         for k, (var, method) in per[r.name].items():
             if method in UPPER_BOUNDS:
                 lowest[k] = min(lowest.get(k, np.inf), var)
+                lowest_relative[k] = min(lowest_relative.get(k, np.inf), var / np.mean(r.outputs[k] ** 2))
     out = {}
     for r in records:
         ratios, methods = [], []
@@ -119,6 +124,8 @@ def noise_estimates(records: list[Record]) -> dict[str, tuple[float, str]]:
             var, method = per[r.name][k]
             if method in UPPER_BOUNDS and len(records) > 1:
                 var, method = lowest[k], f"{method}, lowest level"
+                if level_scaled:
+                    var = max(var, lowest_relative[k] * np.mean(y**2))
             ratios.append(max(var, _resolution_variance(y)) / np.mean(y**2))
             methods.append(method)
         out[r.name] = (float(np.sqrt(np.mean(ratios))), methods[0])

@@ -42,6 +42,13 @@ def _gap(sims: dict, records, held, bands, floors: dict) -> dict:
     }
 
 
+def _scaled_floor(gap: dict) -> str:
+    """The report's words for the floor should the sensor noise grow with the level, where it is higher."""
+    scaled = gap.get("noise_floor_scaled", gap["noise_floor"])
+    return (f"; {scaled:.4f} should the sensor noise grow with the level (the combinations are judged above it)"
+            if scaled > 1.01 * gap["noise_floor"] else "")
+
+
 def _free_values(fit) -> dict:
     out = {n: fit.params[n] for n in fit.free}
     if "hysteresis" in fit.effect.split(" + ") and "delta" in fit.free:  # the SDOF form: β·γ, β·δ identifiable
@@ -53,12 +60,16 @@ def _free_values(fit) -> dict:
 
 def nominal_gap(sims: dict, records, held, bands, cfg) -> dict:
     """The nominal model's gap (where), its noise floor from the held-out data, and whether the gap is
-    significant: larger than noise_factor x the floor and than the floor + min_gap."""
+    significant: larger than noise_factor x the floor and than the floor + min_gap. Also the floor should the
+    sensor noise grow with the level (noise_floor_scaled, localise.noise_estimates(level_scaled=True)): what the
+    forward selection measures a model's misfit above."""
     floors = localise.noise_estimates(records)
     gap = _gap(sims, records, held, bands, floors)
     estimates = [floors[r.name] for r in held]
     floor = _rms_over([e[0] for e in estimates])
     gap["noise_floor"] = floor
+    scaled = localise.noise_estimates(records, level_scaled=True)
+    gap["noise_floor_scaled"] = _rms_over([scaled[r.name][0] for r in held])
     gap["noise_floor_method"] = sorted({e[1] for e in estimates})
     worst = int(np.nanargmax([b["nrmse"] for b in gap["by_band"]]))
     gap["worst_band_hz"] = gap["by_band"][worst]["band_hz"]
@@ -326,7 +337,8 @@ def markdown(result: dict) -> str:
         f"{', '.join(result['held_out_files'])}. Levels ordered by {result['level_order']}.",
         "",
         f"Held-out gap (NRMSE) of the nominal model: **{g['overall']:.4f}**; noise floor from the data: "
-        f"{g['noise_floor']:.4f} ({', '.join(g.get('noise_floor_method', []))}); nominal calibration NRMSE "
+        f"{g['noise_floor']:.4f} ({', '.join(g.get('noise_floor_method', []))}){_scaled_floor(g)}; nominal "
+        f"calibration NRMSE "
         f"{result['nominal']['calibration_nrmse']:.4f}. An effect explains the gap when the held-out NRMSE with "
         f"it is at most {result['explained_below']:.4f}.", "", "## Which effect", "",
         "| effect | score | held-out gap after | shrink [%] | screening [%] | strength params | fitted |",

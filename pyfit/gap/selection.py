@@ -40,8 +40,8 @@ def score(before: float, after: float, reference: float, strengths: int) -> floa
 
 def adds_enough(smaller_after: float, larger_after: float, floor: float, min_excess_cut: float) -> bool:
     """Whether a model with more effects earns them: it removes at least `min_excess_cut` of the held-out misfit
-    above the noise floor that the smaller model leaves."""
-    return larger_after - floor <= (1.0 - min_excess_cut) * (smaller_after - floor)
+    above the noise floor that the smaller model leaves (never when the smaller one leaves none)."""
+    return smaller_after > floor and larger_after - floor <= (1.0 - min_excess_cut) * (smaller_after - floor)
 
 
 def nothing_to_add(nrmse: float, explained_below: float, partner_explained: list[float],
