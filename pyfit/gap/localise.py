@@ -98,7 +98,13 @@ def local_polynomial_noise(u: np.ndarray, y: np.ndarray, degree: int = 2, half_w
 UPPER_BOUNDS = ("unexcited lines", "quiet band", "local polynomial")  # methods that count distortion as noise too
 
 
-def noise_estimates(records: list[Record], level_scaled: bool = False) -> dict[str, tuple[float, str]]:
+def channel_noise(records: list[Record]) -> dict[str, dict[str, tuple[float, str]]]:
+    """Each record's noise variance per output channel and its method (_noise_variance), by record name."""
+    return {r.name: {k: _noise_variance(r, y) for k, y in r.outputs.items()} for r in records}
+
+
+def noise_estimates(records: list[Record], level_scaled: bool = False,
+                    per: dict | None = None) -> dict[str, tuple[float, str]]:
     """Each record's noise floor as an NRMSE (over its output channels) and the method used (see
     _noise_variance); never below the writer's rounding, so never zero.
 
@@ -109,8 +115,9 @@ def noise_estimates(records: list[Record], level_scaled: bool = False) -> dict[s
 
     level_scaled: the estimate for sensor noise that may instead grow in proportion to the level (a data
     acquisition whose input range is set per level): the larger of that bound and the lowest level's noise
-    relative to its own power, times the record's power (each at most the record's own estimate)."""
-    per = {r.name: {k: _noise_variance(r, y) for k, y in r.outputs.items()} for r in records}
+    relative to its own power, times the record's power (each at most the record's own estimate).
+    per: channel_noise(records) when already computed."""
+    per = per or channel_noise(records)
     lowest, lowest_relative = {}, {}
     for r in records:
         for k, (var, method) in per[r.name].items():

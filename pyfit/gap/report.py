@@ -63,12 +63,13 @@ def nominal_gap(sims: dict, records, held, bands, cfg) -> dict:
     significant: larger than noise_factor x the floor and than the floor + min_gap. Also the floor should the
     sensor noise grow with the level (noise_floor_scaled, localise.noise_estimates(level_scaled=True)): what the
     forward selection measures a model's misfit above."""
-    floors = localise.noise_estimates(records)
+    per = localise.channel_noise(records)
+    floors = localise.noise_estimates(records, per=per)
     gap = _gap(sims, records, held, bands, floors)
     estimates = [floors[r.name] for r in held]
     floor = _rms_over([e[0] for e in estimates])
     gap["noise_floor"] = floor
-    scaled = localise.noise_estimates(records, level_scaled=True)
+    scaled = localise.noise_estimates(records, level_scaled=True, per=per)
     gap["noise_floor_scaled"] = _rms_over([scaled[r.name][0] for r in held])
     gap["noise_floor_method"] = sorted({e[1] for e in estimates})
     worst = int(np.nanargmax([b["nrmse"] for b in gap["by_band"]]))
