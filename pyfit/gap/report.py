@@ -339,8 +339,7 @@ def markdown(result: dict) -> str:
         "",
         f"Held-out gap (NRMSE) of the nominal model: **{g['overall']:.4f}**; noise floor from the data: "
         f"{g['noise_floor']:.4f} ({', '.join(g.get('noise_floor_method', []))}){_scaled_floor(g)}; nominal "
-        f"calibration NRMSE "
-        f"{result['nominal']['calibration_nrmse']:.4f}. An effect explains the gap when the held-out NRMSE with "
+        f"calibration NRMSE {result['nominal']['calibration_nrmse']:.4f}. An effect explains the gap when the held-out NRMSE with "
         f"it is at most {result['explained_below']:.4f}.", "", "## Which effect", "",
         "| effect | score | held-out gap after | shrink [%] | screening [%] | strength params | fitted |",
         "|---|---|---|---|---|---|---|"]
