@@ -57,6 +57,7 @@ class FitTask:
     basin: callable = None  # start values -> their basin: refit from the best start of each (a module-level
     # function, so the task pickles to a worker)
     probes: int = 1  # without a basin: the best starts descended before the best of them goes on
+    probed: tuple = ()  # starts (dicts of parameter overrides) descended as probes too, whatever their misfit
 
 
 class UnitScaling:
@@ -110,7 +111,8 @@ def run_fit(task: FitTask) -> Fit:
     the best point they evaluated. With task.basin the same from the best start of each basin (an SDOF loop
     has one at each ν, which sets the scale of β, and width: systems.sdof_loop_basin), each with BASIN_SHARE
     of the budget first, then the best of them with the whole budget; without it, likewise from the
-    task.probes best starts (a combination's starts lead to different local optima of its many parameters)."""
+    task.probes best starts and task.probed (a combination's starts lead to different local optima of its many
+    parameters)."""
     t0 = time.perf_counter()
     threads = max(1, min(task.threads, len(task.records)))
     runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
@@ -128,7 +130,8 @@ def run_fit(task: FitTask) -> Fit:
         return float(np.sum(residuals(params(x)) ** 2))
 
     # find the basins: the starts with the best time-domain residual
-    candidates = [unit.scaled(task.start)] + [unit.scaled({**task.start, **alt}) for alt in task.alternatives]
+    candidates = [unit.scaled(task.start)] + [unit.scaled({**task.start, **alt})
+                                              for alt in task.alternatives + task.probed]
     errors = [cost(x) for x in candidates]
     used = len(candidates)
     stages = []
@@ -164,8 +167,10 @@ def run_fit(task: FitTask) -> Fit:
     if task.basin:
         for k in order:
             firsts.setdefault(task.basin(unit.values(candidates[k])), k)
-    elif task.probes > 1:
+    elif task.probes > 1 or task.probed:
         firsts = dict(enumerate(order[:task.probes]))
+        forced = range(len(candidates) - len(task.probed), len(candidates))
+        firsts.update({f"probed {k}": k for k in forced if k not in firsts.values()})
     if firsts:
         for k in firsts.values():
             x, e, n = descend(candidates[k], errors[k], max(1, int(task.budget * BASIN_SHARE)))
@@ -202,7 +207,8 @@ def pinned(task: FitTask, values: dict, budget: int) -> FitTask:
                     ({n: v for n, v in alt.items() if n not in values} for alt in task.alternatives)}
     return dataclasses.replace(task, fixed={**task.fixed, **values}, start=free,
                                bounds={n: task.bounds[n] for n in free}, alternatives=tuple(alternatives.values()),
-                               log_scaled=tuple(n for n in task.log_scaled if n in free), budget=budget, probes=1)
+                               log_scaled=tuple(n for n in task.log_scaled if n in free), budget=budget, probes=1,
+                               probed=())
 
 
 STIFFNESS_SCAN = (0.25, 0.5, 1.0, 2.0, 4.0)  # factors on the nominal stiffness tried before the least squares

@@ -218,7 +218,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     best combination when it removes `min_excess_cut` of the misfit above the floor that the model it extends
     leaves once refitted on with a combination's budget (the combinations start from that refit and never end
     worse than it) or, when lower, the misfit of the control's joint refit (what the combination's extra
-    evaluations alone buy the model it extends: selection.budget_control), up to `cfg.max_effects` members.
+    evaluations alone buy the model it extends, counted with the control's partner at zero:
+    selection.budget_control), up to `cfg.max_effects` members.
     The noise these tests measure a misfit above is the floor should the sensor noise grow with the level
     (gap["noise_floor_scaled"]): a floor taken too low asks a right pair to remove half of a misfit that is noise.
     A path's end is checked backward: the model without its last-added member is refitted from the end's
@@ -247,12 +248,21 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         return system, None
     effects = dict(system.effects)
     named = {frozenset([n]): n for n in fits}  # members -> the name their model is stored under
+    beside_only = set()  # combinations whose fit so far is a refit beside one path's model (no joint refit)
     controls = {}  # a combination -> what refitting on alone bought the model it extends (selection.budget_control)
 
     def simulated(name):
         sims[name] = {r.name: sim.simulate(runner, r, fits[name].params, cfg.upsample, system.lead_periods)
                       for r in held}
         after[name] = selection.heldout_nrmse(sims[name], held)
+
+    def without_partner(name, task, added: dict):
+        # the held-out misfit of a combination's joint refit with its last member at zero: the model it extends at
+        # the values that refit found (a control whose partner stands in for the true one, a loop for a hardening
+        # spring, then does not count as what more evaluations alone buy the model it extends)
+        values = {**fits[name].params, **{n: task.floor[n] for n in added}}
+        return selection.heldout_nrmse({r.name: sim.simulate(runner, r, values, cfg.upsample, system.lead_periods)
+                                        for r in held}, held)
 
     def grow(current):
         while len(effects[current].members or (current,)) < cfg.max_effects and left(current):
@@ -280,10 +290,13 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 break
             for partner in sorted(others, key=lambda n: -explained[n])[:cfg.partners]:
                 together = frozenset(members + [partner])
-                if together in named:  # reached from another single effect
+                if together in named and named[together] not in beside_only:  # refitted jointly on another path
                     names.append(named[together])
                     continue
-                combo = combine([system.effects[m] for m in members + [partner]])
+                # new, or reached from another path that held only its other member(s) at their refit: refitted
+                # beside this path's model too (a weak loop beside a strong spring is found beside the spring)
+                combo = effects[named[together]] if together in named else combine(
+                    [system.effects[m] for m in members + [partner]])
                 effects[combo.name], named[together] = combo, combo.name
                 names.append(combo.name)
                 seeds = _combination_seeds(system, scale, fits[current].params, members, fits[partner].params,
@@ -304,28 +317,42 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 new.append((combo.name, task, so_far, {n: fits[partner].params[n] for n in added}))
             # every partner first beside the model so far held (half a refit's budget, no probes); the joint
             # refit then only for the partner that helps most there and, as the control, the one that helps least
-            beside = _fits_of([(pinned(task, so_far, cfg.refit_budget // 2), out / "fits" / f"{_stem(n)}.beside.json")
+            beside = _fits_of([(pinned(task, so_far, cfg.refit_budget // 2),
+                                out / "fits" / f"{_stem(n)}.beside.{_stem(current)}.json")
                                for n, task, so_far, _ in new], key, alone, workers, progress, "partners beside")
+            own = dict(beside)  # the refits beside this path's model (a joint refit starts from them too)
+            for name, fit in own.items():  # a refit beside another path's model stays when it fits better
+                if name in fits and fits[name].calibration_nrmse <= fit.calibration_nrmse:
+                    beside[name] = fits[name]
             # (by the calibration misfit the refits beside minimised: a hardening spring held at its own refit
             # can jump on a held-out sweep where the partner's refit beside it does not tell that partner apart)
             order = sorted(beside, key=lambda n: beside[n].calibration_nrmse)
             joint = {order[0], order[-1]} if len(names) >= selection.CONTROL_SIBLINGS else set(order[:1])
-            for name in set(beside) - joint:  # its fit is the one beside the model so far
-                fits[name] = beside[name]
+            for name in set(beside) - joint:  # its fit is the best one beside a path's model so far
+                if fits.get(name) is not beside[name]:
+                    fits[name] = beside[name]
+                    sims.pop(name, None)
+                beside_only.add(name)
+            # (from the best refit beside a path's model among its starts, and probed from this path's own: a weak
+            # loop beside a strong spring's refit misfits more than a loop standing in for the spring)
             jointly = _fits_of([(dataclasses.replace(task, alternatives=task.alternatives + (
-                {n: beside[name].params[n] for n in task.start},)), out / "fits" / f"{_stem(name)}.json",
+                {n: beside[name].params[n] for n in task.start},), probed=({n: own[name].params[n] for n in task.start},)),
+                out / "fits" / f"{_stem(name)}.json",
                 pinned(task, side, cfg.refit_budget // 2)) for name, task, _, side in new if name in joint],
                 key, alone, workers, progress, "combinations")
             for name, fit in jointly.items():  # its cost includes the refit beside the model so far
                 fits[name] = dataclasses.replace(fit, evaluations=fit.evaluations + beside[name].evaluations,
                                                  wall_s=fit.wall_s + beside[name].wall_s)
+                sims.pop(name, None)
+                beside_only.discard(name)
             for name in names:
                 if name not in after or name not in sims:
                     simulated(name)
             best = min(names, key=lambda n: after[n], default=None)
-            least = order[-1] if order else max(names, key=lambda n: after[n], default=None)
-            control = selection.budget_control(after[least], len(names)) if least not in (None, best) \
-                else float("inf")
+            least = order[-1] if order else None
+            control = selection.budget_control(without_partner(least, *next(
+                (task, side) for n, task, _, side in new if n == least)), len(names)) \
+                if least not in (None, best) else float("inf")
             for name in names:  # the lowest control any of its refits met
                 controls[name] = min(controls.get(name, float("inf")), control)
             if best is None or not selection.adds_enough(min(after[current], controls[best]), after[best], above,

@@ -98,9 +98,11 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
     model the forward selection kept; the other combinations it tried are reported but not chosen."""
     floor, before, significant = gap["noise_floor"], gap["overall"], gap["significant"]
     afters = {name: selection.heldout_nrmse(sims[name], held) for name in fits}
-    # the floor is an upper bound where distortion counts as noise (localise.UPPER_BOUNDS); so is any model's
-    # held-out misfit: the shrink is measured against the smaller of the two
-    reference = min([floor] + list(afters.values()))
+    # the floor should the sensor noise grow with the level is an upper bound of the noise (it counts distortion
+    # as noise; at least the floor); so is any model's held-out misfit: the shrink is measured against the
+    # smaller of the two (against the floor alone, a right effect on noise that grows with the level would have
+    # to remove a misfit that is noise)
+    reference = min([gap.get("noise_floor_scaled", floor)] + list(afters.values()))
     gap["shrink_reference"] = reference
     ranking = []
     for name, fit in fits.items():
@@ -356,7 +358,8 @@ def markdown(result: dict) -> str:
         lines += ["", "Score = shrink − 5 points per added strength parameter beyond the first (shape parameters "
                   "are not charged). "
                   "Shrink = (gap before − gap after) / (gap before − reference), reference = the smaller of the "
-                  "noise floor and the best held-out gap after (both are upper bounds of the noise)."]
+                  "noise floor should the sensor noise grow with the level and the best held-out gap after (both "
+                  "are upper bounds of the noise)."]
     elif result["verdict"] == "no significant gap":
         lines += ["", "No effect was refitted: the nominal model fits the held-out files within the noise floor."]
     else:

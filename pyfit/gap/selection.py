@@ -54,9 +54,10 @@ def nothing_to_add(nrmse: float, explained_below: float, partner_explained: list
 
 def budget_control(least_helpful_nrmse: float, siblings: int, min_siblings: int = CONTROL_SIBLINGS) -> float:
     """What more refit evaluations alone buy a model being extended: the held-out NRMSE of the joint refit of its
-    extension whose added effect helped least (of `min_siblings` or more extensions tried from the same model,
-    the least helpful one's added effect explains ~nothing, so its gain is the model's own parameters refitted
-    on). inf when fewer extensions were tried (no control)."""
+    extension whose added effect helped least, evaluated with that effect at zero (of `min_siblings` or more
+    extensions tried from the same model, the least helpful one's added effect explains ~nothing, so its gain is
+    the model's own parameters refitted on; at zero, an added effect that stands in for the true one does not
+    count). inf when fewer extensions were tried (no control)."""
     return least_helpful_nrmse if siblings >= min_siblings else float("inf")
 
 
