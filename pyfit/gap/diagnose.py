@@ -214,7 +214,9 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     `cfg.min_partner_explained` of that residual: the path and the search end there). Each partner is refitted
     beside the model so far held at its own refit (attribute.pinned); the one that helps most there, and the one
     that helps least (the control), are then refitted jointly (from each member's own refit, the effects' starts,
-    the partner's refit beside the model and the members refitted beside the partner's refit). Go on from the
+    the partner's refit beside the model and the members refitted beside the partner's refit; a combination
+    reached from two paths is refitted beside each path's model, the better kept, and its joint refit probes
+    from its own path's refit beside too). Go on from the
     best combination when it removes `min_excess_cut` of the misfit above the floor that the model it extends
     leaves once refitted on with a combination's budget (the combinations start from that refit and never end
     worse than it) or, when lower, the misfit of the control's joint refit (what the combination's extra
@@ -335,9 +337,9 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 beside_only.add(name)
             # (from the best refit beside a path's model among its starts, and probed from this path's own: a weak
             # loop beside a strong spring's refit misfits more than a loop standing in for the spring)
-            jointly = _fits_of([(dataclasses.replace(task, alternatives=task.alternatives + (
-                {n: beside[name].params[n] for n in task.start},), probed=({n: own[name].params[n] for n in task.start},)),
-                out / "fits" / f"{_stem(name)}.json",
+            jointly = _fits_of([(dataclasses.replace(
+                task, alternatives=task.alternatives + ({n: beside[name].params[n] for n in task.start},),
+                probed=({n: own[name].params[n] for n in task.start},)), out / "fits" / f"{_stem(name)}.json",
                 pinned(task, side, cfg.refit_budget // 2)) for name, task, _, side in new if name in joint],
                 key, alone, workers, progress, "combinations")
             for name, fit in jointly.items():  # its cost includes the refit beside the model so far
