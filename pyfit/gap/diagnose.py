@@ -253,18 +253,18 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     beside_only = set()  # combinations whose fit so far is a refit beside one path's model (no joint refit)
     controls = {}  # a combination -> what refitting on alone bought the model it extends (selection.budget_control)
 
+    def on_held(values):  # the held-out records simulated with `values`
+        return {r.name: sim.simulate(runner, r, values, cfg.upsample, system.lead_periods) for r in held}
+
     def simulated(name):
-        sims[name] = {r.name: sim.simulate(runner, r, fits[name].params, cfg.upsample, system.lead_periods)
-                      for r in held}
+        sims[name] = on_held(fits[name].params)
         after[name] = selection.heldout_nrmse(sims[name], held)
 
     def without_partner(name, task, added: dict):
         # the held-out misfit of a combination's joint refit with its last member at zero: the model it extends at
         # the values that refit found (a control whose partner stands in for the true one, a loop for a hardening
         # spring, then does not count as what more evaluations alone buy the model it extends)
-        values = {**fits[name].params, **{n: task.floor[n] for n in added}}
-        return selection.heldout_nrmse({r.name: sim.simulate(runner, r, values, cfg.upsample, system.lead_periods)
-                                        for r in held}, held)
+        return selection.heldout_nrmse(on_held({**fits[name].params, **{n: task.floor[n] for n in added}}), held)
 
     def grow(current):
         while len(effects[current].members or (current,)) < cfg.max_effects and left(current):
@@ -352,8 +352,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                     simulated(name)
             best = min(names, key=lambda n: after[n], default=None)
             least = order[-1] if order else None
-            control = selection.budget_control(without_partner(least, *next(
-                (task, side) for n, task, _, side in new if n == least)), len(names)) \
+            tried = {n: (task, side) for n, task, _, side in new}
+            control = selection.budget_control(without_partner(least, *tried[least]), len(names)) \
                 if least not in (None, best) else float("inf")
             for name in names:  # the lowest control any of its refits met
                 controls[name] = min(controls.get(name, float("inf")), control)
