@@ -16,6 +16,9 @@ def test_wilson_interval_solves_its_defining_equation(right, of):
     expected_low = 0.0 if right == 0 else scipy.optimize.brentq(gap, 1e-12, p_hat - 1e-9, xtol=1e-14)
     expected_high = 1.0 if right == of else scipy.optimize.brentq(gap, p_hat + 1e-9, 1 - 1e-12, xtol=1e-14)
     assert low == pytest.approx(expected_low, abs=1e-9) and high == pytest.approx(expected_high, abs=1e-9)
+    # the stated rate is the interval's centre where neither end is clipped at 0 or 1
+    if 0 < right < of:
+        assert confidence.wilson_centre(right, of) == pytest.approx((low + high) / 2, abs=1e-12)
 
 
 def _outcome(withheld, named, shrink, verdict=None, stated=None):
@@ -39,11 +42,14 @@ def test_calibration_counts_each_shrink_bin_and_the_quiet_verdicts():
 def test_a_report_states_the_hit_rate_of_its_bin_and_none_without_one():
     cal = confidence.calibration_of(OUTCOMES, "stockbridge diagnose --campaign 17 --campaign-seed 4", 4)
     named = confidence.stated("gap explained by hysteresis", "hysteresis", 96.5, cal)
-    assert named["rate"] == pytest.approx(0.7) and (named["right"], named["of"]) == (7, 10)
+    # the Wilson centre (7 + 1.96²/2) / (10 + 1.96²): a bin of ten reports states less than its raw 70 %
+    assert named["rate"] == pytest.approx(8.9208 / 13.8416, abs=1e-6) and (named["right"], named["of"]) == (7, 10)
     assert (named["low"], named["high"]) == pytest.approx(confidence.wilson(7, 10))
     assert "7 of the 10 reports" in confidence.Confidence(**named).sentence()
     quiet = confidence.stated("no significant gap", None, None, cal)
-    assert quiet["rate"] == pytest.approx(0.8)
+    assert quiet["rate"] == pytest.approx((4 + 1.9208) / (5 + 3.8416), abs=1e-6)
+    one = confidence.calibration_of([_outcome("hysteresis", "cubic_stiffness", 70.0)], "one case", 0)
+    assert 0.2 < confidence.stated("gap explained by cubic_stiffness", "cubic_stiffness", 70.0, one)["rate"] < 0.5
     assert confidence.stated("gap explained by cubic_stiffness", "cubic_stiffness", 70.0, cal) is None  # no case
     assert confidence.stated("gap not explained by the candidate effects", None, 60.0, cal) is None
     assert confidence.stated("no significant gap", None, None, None) is None

@@ -62,6 +62,19 @@ def test_a_pair_must_beat_what_refitting_on_alone_buys_the_model_it_extends():
                                        selection.budget_control(0.0106, 2)) == 1
 
 
+def test_the_best_leaner_partner_beside_a_model_is_refitted_jointly_too():
+    """Calibration misfits of the refits beside friction held at its own refit, campaign seed 16 case 194
+    (Coulomb friction with quadratic damping withheld): the free-shape loop (six effect parameters with the
+    friction's two) leaves 0.0300, the true partner (three) 0.0333, a hardening spring 0.0367, a delay
+    0.0370. The loop leads; of the leaner ones the quadratic damping also gets the joint refit. Beside a loop
+    every one-parameter partner is as lean: no other."""
+    order = ["friction + loop", "friction + quadratic", "friction + cubic", "friction + delay"]
+    sizes = {"friction + loop": 6, "friction + quadratic": 3, "friction + cubic": 3, "friction + delay": 3}
+    assert selection.leaner_best(order, sizes) == ["friction + quadratic"]
+    assert selection.leaner_best(order[1:], sizes) == []
+    assert selection.leaner_best([], {}) == []
+
+
 def test_a_model_that_explains_the_data_with_nothing_a_candidate_explains_left_is_not_extended():
     """The screening repeated at the model so far (fractions of its calibration residual), with numbers of the
     diagnoses that found them. Lab sweeps of the family's hysteresis (accelerometer files, floor estimate 0.0036):

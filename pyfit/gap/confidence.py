@@ -2,8 +2,8 @@
 
 The campaign counts, per bin of the named model's held-out shrink, how many reports named an effect and how many
 of those were right; and how many 'no significant gap' verdicts had nothing withheld. A single report states the
-hit rate of its bin with the Wilson 95 % interval of that count (few cases give a wide interval, and the report
-says so). The package carries the calibration of one campaign (calibration.json beside this module, written by
+hit rate of its bin as the centre of the Wilson 95 % interval of that count, with the interval (few cases give
+a wide interval, and the report says so; the centre keeps a bin of one or two reports from stating 0 or 100 %). The package carries the calibration of one campaign (calibration.json beside this module, written by
 `stockbridge diagnose --campaign N --calibrate`); a campaign with other cases checks how well the stated
 confidence matches what happens.
 """
@@ -24,8 +24,8 @@ STATED_BINS = (0.0, 0.5, 0.8, 0.95, 1.0 + 1e-9)  # stated confidence, for the ch
 
 @dataclass(frozen=True)
 class Confidence:
-    """The hit rate `right`/`of` of the campaign's reports like this one (`alike`), its Wilson 95 % interval
-    [low, high], and the campaign it comes from (`source`: its command, `seed`, `cases`)."""
+    """The hit rate of the campaign's reports like this one (`alike`: `right` of `of`) as the centre of its Wilson
+    95 % interval [low, high], and the campaign it comes from (`source`: its command, `seed`, `cases`)."""
 
     rate: float
     right: int
@@ -52,6 +52,12 @@ def wilson(right: int, of: int, z: float = 1.96) -> tuple[float, float]:
     centre = (p + z * z / (2 * of)) / (1 + z * z / of)
     half = z * math.sqrt(p * (1 - p) / of + z * z / (4 * of * of)) / (1 + z * z / of)
     return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def wilson_centre(right: int, of: int, z: float = 1.96) -> float:
+    """Centre of the Wilson score interval, (right + z²/2) / (of + z²): the hit rate pulled towards 1/2 by as much
+    as the count is small (0.5 when of = 0)."""
+    return (right + z * z / 2) / (of + z * z)
 
 
 def bin_of(value: float | None, edges) -> int | None:
@@ -111,7 +117,7 @@ def stated(verdict: str, chosen: str | None, shrink_pct: float | None, calibrati
     if of == 0:
         return None
     low, high = wilson(right, of)
-    return asdict(Confidence(right / of, right, of, low, high, alike, calibration["source"], calibration["seed"],
+    return asdict(Confidence(wilson_centre(right, of), right, of, low, high, alike, calibration["source"], calibration["seed"],
                              calibration["cases"]))
 
 

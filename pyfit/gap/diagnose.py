@@ -212,8 +212,9 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     whose sensitivity at that model explains most of its calibration residual (the screening repeated there;
     none when the model already meets the absolute criterion and no candidate explains
     `cfg.min_partner_explained` of that residual: the path and the search end there). Each partner is refitted
-    beside the model so far held at its own refit (attribute.pinned); the one that helps most there, and the one
-    that helps least (the control), are then refitted jointly (from each member's own refit, the effects' starts,
+    beside the model so far held at its own refit (attribute.pinned); the one that helps most there, the best of
+    those with fewer parameters than it (selection.leaner_best: a free-shape loop absorbs most beside a held
+    model), and the one that helps least (the control), are then refitted jointly (from each member's own refit, the effects' starts,
     the partner's refit beside the model and the members refitted beside the partner's refit; a combination
     reached from two paths is refitted beside each path's model, the better kept, and its joint refit probes
     from its own path's refit beside too). Go on from the
@@ -330,6 +331,10 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             # can jump on a held-out sweep where the partner's refit beside it does not tell that partner apart)
             order = sorted(beside, key=lambda n: beside[n].calibration_nrmse)
             joint = {order[0], order[-1]} if len(names) >= selection.CONTROL_SIBLINGS else set(order[:1])
+            # a partner with many free parameters (a free-shape loop) absorbs more beside a held model than one
+            # with few, whose member held at a refit that made up for it holds it back (a cubic spring stiffened
+            # less, a viscous damper raised for a quadratic one): the best of the leaner ones is refitted jointly too
+            joint |= set(selection.leaner_best(order, {n: len(effects[n].params) for n in order}))
             for name in set(beside) - joint:  # its fit is the best one beside a path's model so far
                 if fits.get(name) is not beside[name]:
                     fits[name] = beside[name]

@@ -61,6 +61,11 @@ def budget_control(least_helpful_nrmse: float, siblings: int, min_siblings: int 
     return least_helpful_nrmse if siblings >= min_siblings else float("inf")
 
 
+def leaner_best(order: list[str], sizes: dict[str, int]) -> list[str]:
+    """Of models listed best first, the best one with fewer parameters than the first ([] when none has)."""
+    return [n for n in order if sizes[n] < sizes[order[0]]][:1] if order else []
+
+
 def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, min_excess_cut: float,
                       control: float = float("inf")) -> int:
     """Of two models given as (number of effects, held-out NRMSE), the index (0: a, 1: b) of the one kept: of
