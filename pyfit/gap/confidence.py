@@ -3,7 +3,8 @@
 The campaign counts, per bin of the named model's held-out shrink, how many reports named an effect and how many
 of those were right; and how many 'no significant gap' verdicts had nothing withheld. A single report states the
 hit rate of its bin as the centre of the Wilson 95 % interval of that count, with the interval (few cases give
-a wide interval, and the report says so; the centre keeps a bin of one or two reports from stating 0 or 100 %). The package carries the calibration of one campaign (calibration.json beside this module, written by
+a wide interval, and the report says so; the centre keeps a bin of one or two reports from stating 0 or 100 %).
+The package carries the calibration of one campaign (calibration.json beside this module, written by
 `stockbridge diagnose --campaign N --calibrate`); a campaign with other cases checks how well the stated
 confidence matches what happens.
 """
@@ -117,8 +118,8 @@ def stated(verdict: str, chosen: str | None, shrink_pct: float | None, calibrati
     if of == 0:
         return None
     low, high = wilson(right, of)
-    return asdict(Confidence(wilson_centre(right, of), right, of, low, high, alike, calibration["source"], calibration["seed"],
-                             calibration["cases"]))
+    return asdict(Confidence(wilson_centre(right, of), right, of, low, high, alike, calibration["source"],
+                             calibration["seed"], calibration["cases"]))
 
 
 def check(outcomes: list[dict]) -> list[dict]:

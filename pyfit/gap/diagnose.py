@@ -214,8 +214,9 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     `cfg.min_partner_explained` of that residual: the path and the search end there). Each partner is refitted
     beside the model so far held at its own refit (attribute.pinned); the one that helps most there, the best of
     those with fewer parameters than it (selection.leaner_best: a free-shape loop absorbs most beside a held
-    model), and the one that helps least (the control), are then refitted jointly (from each member's own refit, the effects' starts,
-    the partner's refit beside the model and the members refitted beside the partner's refit; a combination
+    model), and the one that helps least (the control), are then refitted jointly (from each member's own refit,
+    the effects' starts, the partner's refit beside the model and the members refitted beside the partner's
+    refit; a combination
     reached from two paths is refitted beside each path's model, the better kept, and its joint refit probes
     from its own path's refit beside too). Go on from the
     best combination when it removes `min_excess_cut` of the misfit above the floor that the model it extends
