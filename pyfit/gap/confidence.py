@@ -45,20 +45,19 @@ class Confidence:
                 f"{self.of} reports {self.alike} were right.")
 
 
-def wilson(right: int, of: int, z: float = 1.96) -> tuple[float, float]:
-    """Wilson score interval of a binomial proportion right/of (z = 1.96: 95 %)."""
-    if of == 0:
-        return 0.0, 1.0
-    p = right / of
-    centre = (p + z * z / (2 * of)) / (1 + z * z / of)
-    half = z * math.sqrt(p * (1 - p) / of + z * z / (4 * of * of)) / (1 + z * z / of)
-    return max(0.0, centre - half), min(1.0, centre + half)
-
-
 def wilson_centre(right: int, of: int, z: float = 1.96) -> float:
     """Centre of the Wilson score interval, (right + z²/2) / (of + z²): the hit rate pulled towards 1/2 by as much
     as the count is small (0.5 when of = 0)."""
     return (right + z * z / 2) / (of + z * z)
+
+
+def wilson(right: int, of: int, z: float = 1.96) -> tuple[float, float]:
+    """Wilson score interval of a binomial proportion right/of (z = 1.96: 95 %), about wilson_centre."""
+    if of == 0:
+        return 0.0, 1.0
+    p, centre = right / of, wilson_centre(right, of, z)
+    half = z * math.sqrt(p * (1 - p) / of + z * z / (4 * of * of)) / (1 + z * z / of)
+    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def bin_of(value: float | None, edges) -> int | None:

@@ -216,10 +216,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     those with fewer parameters than it (selection.leaner_best: a free-shape loop absorbs most beside a held
     model), and the one that helps least (the control), are then refitted jointly (from each member's own refit,
     the effects' starts, the partner's refit beside the model and the members refitted beside the partner's
-    refit; a combination
-    reached from two paths is refitted beside each path's model, the better kept, and its joint refit probes
-    from its own path's refit beside too). Go on from the
-    best combination when it removes `min_excess_cut` of the misfit above the floor that the model it extends
+    refit; a combination reached from two paths is refitted beside each path's model, the better kept, and its
+    joint refit probes from its own path's refit beside too). Go on from the best combination when it removes `min_excess_cut` of the misfit above the floor that the model it extends
     leaves once refitted on with a combination's budget (the combinations start from that refit and never end
     worse than it) or, when lower, the misfit of the control's joint refit (what the combination's extra
     evaluations alone buy the model it extends, counted with the control's partner at zero:
