@@ -328,6 +328,23 @@ def _restoring_force_loops(path, records, sims, models, k, mass: float) -> None:
                 "restoring force against displacement at the largest response, per level")
 
 
+LISTED_IN_FULL = 12  # starts written out one by one in report.md; more are summarised by parameter
+
+
+def starts_text(starts: list[dict]) -> str:
+    """A candidate's listed starts for report.md: each start when there are at most LISTED_IN_FULL, else each
+    parameter's values (its range when there are more than six) and where the full list is (report.json)."""
+    if len(starts) <= LISTED_IN_FULL:
+        return "; ".join(", ".join(f"{k} = {v:g}" for k, v in st.items()) for st in starts)
+    names = list(dict.fromkeys(k for st in starts for k in st))
+    parts = []
+    for n in names:
+        values = sorted({float(f"{st[n]:.6g}") for st in starts if n in st})
+        parts.append(f"{n} in {{{', '.join(f'{v:g}' for v in values)}}}" if len(values) <= 6
+                     else f"{n} from {values[0]:g} to {values[-1]:g} ({len(values)} values)")
+    return "; ".join(parts) + " (each start in report.json, `listed_starts`)"
+
+
 def markdown(result: dict) -> str:
     """The report as markdown (tables, evidence, figures)."""
     g = result["gap"]
@@ -351,9 +368,8 @@ def markdown(result: dict) -> str:
                      f"{'—' if r['screening_explained'] is None else format(100 * r['screening_explained'], '.1f')} | "
                      f"{r['n_added_params']} | {params} |")
     for name, starts in result.get("listed_starts", {}).items():
-        listed = "; ".join(", ".join(f"{k} = {v:g}" for k, v in st.items()) for st in starts)
-        lines += ["", f"{name}: besides the screening's strengths, the refit began from the best of these starts on "
-                  f"the calibration files, then fitted every parameter: {listed}."]
+        lines += ["", f"{name}: besides the screening's strengths, the refit began from the best of these "
+                  f"{len(starts)} starts on the calibration files, then fitted every parameter: {starts_text(starts)}."]
     if result["ranking"]:
         lines += ["", "Score = shrink − 5 points per added strength parameter beyond the first (shape parameters "
                   "are not charged). "
