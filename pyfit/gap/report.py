@@ -329,18 +329,20 @@ def _restoring_force_loops(path, records, sims, models, k, mass: float) -> None:
 
 
 LISTED_IN_FULL = 12  # starts written out one by one in report.md; more are summarised by parameter
+VALUES_IN_FULL = 6  # a summarised parameter's values written out; more are given as their range and count
 
 
 def starts_text(starts: list[dict]) -> str:
     """A candidate's listed starts for report.md: each start when there are at most LISTED_IN_FULL, else each
-    parameter's values (its range when there are more than six) and where the full list is (report.json)."""
+    parameter's values (its range when there are more than VALUES_IN_FULL) and where the full list is
+    (report.json)."""
     if len(starts) <= LISTED_IN_FULL:
         return "; ".join(", ".join(f"{k} = {v:g}" for k, v in st.items()) for st in starts)
     names = list(dict.fromkeys(k for st in starts for k in st))
     parts = []
     for n in names:
         values = sorted({float(f"{st[n]:.6g}") for st in starts if n in st})
-        parts.append(f"{n} in {{{', '.join(f'{v:g}' for v in values)}}}" if len(values) <= 6
+        parts.append(f"{n} in {{{', '.join(f'{v:g}' for v in values)}}}" if len(values) <= VALUES_IN_FULL
                      else f"{n} from {values[0]:g} to {values[-1]:g} ({len(values)} values)")
     return "; ".join(parts) + " (each start in report.json, `listed_starts`)"
 
