@@ -96,10 +96,10 @@ def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, po
     return np.concatenate(list(pool.map(one, range(len(records))) if pool else map(one, range(len(records)))))
 
 
-# many starts (a loop's grid of shapes, widths and shares; a combination's members' starts) are ranked first with
-# the FMU's input grid at the sensor rate (upsample 1: under half the cost, the same order of the starts: Spearman
-# 0.999 over the SDOF loop's 359 starts on a campaign sweep and a stepped sine), then the best SCREEN_KEPT of
-# each basin (or of all) again at task.upsample
+# more than SCREEN_FROM starts (a loop's grid of shapes, widths and shares; a combination's members' starts) are
+# ranked first with the FMU's input grid at the sensor rate (upsample 1: under half the cost, and the starts in
+# nearly the same order: tests/test_start_screening.py), then the best SCREEN_KEPT of each basin (or of all, at
+# least task.probes) again at task.upsample
 SCREEN_FROM = 40
 SCREEN_KEPT = 3
 BASIN_SHARE = 1 / 3  # of a refit's budget, for the probe of each basin before the best goes on
