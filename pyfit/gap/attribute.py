@@ -96,6 +96,12 @@ def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, po
     return np.concatenate(list(pool.map(one, range(len(records))) if pool else map(one, range(len(records)))))
 
 
+# more than SCREEN_FROM starts (a loop's grid of shapes, widths and shares; a combination's members' starts) are
+# ranked first with the FMU's input grid at the sensor rate (upsample 1: under half the cost, and the starts in
+# nearly the same order: tests/test_start_screening.py), then the best SCREEN_KEPT of each basin (or of all, at
+# least task.probes) again at task.upsample
+SCREEN_FROM = 40
+SCREEN_KEPT = 3
 BASIN_SHARE = 1 / 3  # of a refit's budget, for the probe of each basin before the best goes on
 # share of a parameter's range a least-squares start is moved off its bounds (optim.baselines.polish): an effect
 # strength started at zero whose value is far below 1 % of its range (a weak quadratic damping beside a strong
@@ -105,7 +111,8 @@ BOUND_MARGIN = 1e-3
 
 def run_fit(task: FitTask) -> Fit:
     """Least squares on the stacked calibration residuals within task.bounds, from the best of task.start and
-    task.alternatives; with task.continuation in stages, each from the best point so far (by the residual of
+    task.alternatives (more than SCREEN_FROM of them ranked at upsample 1 first, then the best of each basin at
+    task.upsample); with task.continuation in stages, each from the best point so far (by the residual of
     every record): the envelopes of non-periodic records (a third of the budget), the lowest level alone (a
     quarter), then every record. Never worse than the best start: each stage and the last least squares keep
     the best point they evaluated. With task.basin the same from the best start of each basin (an SDOF loop
@@ -123,17 +130,27 @@ def run_fit(task: FitTask) -> Fit:
     def params(x):
         return with_derived({**task.fixed, **unit.values(x)}, task.derived)
 
-    def residuals(p, records=task.records, of=sim.residuals):
-        return _stacked(runner, records, p, task.upsample, task.lead_periods, pool, of)
+    def residuals(p, records=task.records, of=sim.residuals, upsample=task.upsample):
+        return _stacked(runner, records, p, upsample, task.lead_periods, pool, of)
 
-    def cost(x):
-        return float(np.sum(residuals(params(x)) ** 2))
+    def cost(x, upsample=task.upsample):
+        return float(np.sum(residuals(params(x), upsample=upsample) ** 2))
 
     # find the basins: the starts with the best time-domain residual
     candidates = [unit.scaled(task.start)] + [unit.scaled({**task.start, **alt})
                                               for alt in task.alternatives + task.probed]
-    errors = [cost(x) for x in candidates]
-    used = len(candidates)
+    forced = range(len(candidates) - len(task.probed), len(candidates))
+    kept, used = range(len(candidates)), 0
+    if len(candidates) > SCREEN_FROM and task.upsample > 1:
+        coarse = [cost(x, upsample=1) for x in candidates]
+        group = (lambda k: task.basin(unit.values(candidates[k]))) if task.basin else (lambda k: None)
+        ranked = {}
+        for k in np.argsort(coarse):
+            ranked.setdefault(group(k), []).append(int(k))
+        kept = {0, *forced, *(k for ks in ranked.values() for k in ks[:max(SCREEN_KEPT, task.probes)])}
+        used = len(candidates)
+    errors = [cost(x) if k in kept else np.inf for k, x in enumerate(candidates)]
+    used += len(kept)
     stages = []
     if task.continuation and not any(r.periodic for r in task.records):
         # a sweep's envelopes first (all levels): smooth in the parameters where the waveform is not
@@ -169,7 +186,6 @@ def run_fit(task: FitTask) -> Fit:
             firsts.setdefault(task.basin(unit.values(candidates[k])), k)
     elif task.probes > 1 or task.probed:
         firsts = dict(enumerate(order[:task.probes]))
-        forced = range(len(candidates) - len(task.probed), len(candidates))
         firsts.update({f"probed {k}": k for k in forced if k not in firsts.values()})
     if firsts:
         for k in firsts.values():

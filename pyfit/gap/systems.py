@@ -216,12 +216,15 @@ _stick_velocity = Param("v_s", lambda s: (1e-3 * s.sigma_v, 1e-2 * s.sigma_v, 0.
 # to (1/sigma_y)·(0.3·k·sigma_y)^(1-ν) (SDOF) or D to sigma_y (damper), the loading branch softens when
 # γ + δ > 0 (SDOF) or β + γ > 0 (damper) and hardens otherwise; the unloading branch likewise with γ - δ or
 # β - γ; ν from 1 (smooth) to 3 (sharp). The refit begins from the best of them on the calibration records and
-# fits the shape.
-SDOF_LOOP_STARTS = ({"gamma": 0.5, "delta": 0.5, "nu": 1.0},    # softening on both branches, wide loop
-                    {"gamma": 1.5, "delta": -0.5, "nu": 1.0},   # softening loading, sharp unloading
-                    {"gamma": 0.5, "delta": -1.5, "nu": 1.0},   # hardening loading, narrow loop
-                    {"gamma": 1.0, "delta": 0.0, "nu": 2.0},    # symmetric, sharper transition
-                    {"gamma": 0.25, "delta": 0.75, "nu": 3.0})  # nearly elastic-plastic
+# fits the shape. The SDOF's five branch shapes are each taken at ν = 1, 2 and 3: a loop's branches and its
+# sharpness vary independently (a sharp loop that softens on both branches lies in no basin a smooth one's
+# descent reaches).
+SDOF_LOOP_BRANCHES = ({"gamma": 0.5, "delta": 0.5},    # softening loading, elastic unloading, wide loop
+                      {"gamma": 1.5, "delta": -0.5},   # softening loading, sharp unloading
+                      {"gamma": 0.5, "delta": -1.5},   # hardening loading, narrow loop
+                      {"gamma": 1.0, "delta": 0.0},    # symmetric
+                      {"gamma": 0.25, "delta": 0.75})  # nearly elastic-plastic
+SDOF_LOOP_STARTS = tuple({**branch, "nu": nu} for nu in (1.0, 2.0, 3.0) for branch in SDOF_LOOP_BRANCHES)
 DAMPER_LOOP_STARTS = ({"a_bw": 0.5, "beta": 0.75, "gamma": 0.25, "nu": 1.0},
                       {"a_bw": 0.1, "beta": 0.5, "gamma": 0.5, "nu": 1.0},
                       {"a_bw": 0.5, "beta": 1.5, "gamma": -0.5, "nu": 1.0},
@@ -232,11 +235,14 @@ DEFAULT_SHARE = 0.1  # share of the stiffness the hysteretic element holds at sm
 BETA_SHARE = 0.3  # the share that sets β's scale (ExponentScaled)
 # the shares each loop width starts from. As listed (width 1: a loop that saturates within the data's deflection),
 # from a weak element (3 %: it saturates early and adds a little stiffness and damping) to a strong one; with γ,
-# δ scaled by 0.1 and by 0.01 (wide loops that barely saturate there, turning over at 10^(1/ν) and 100^(1/ν) times
-# the force β's scale refers to: a mostly elastic element with a little hysteretic damping) at the larger shares
-# only. A strong element with a wide loop and a weak one with a narrow loop share the first-order nonlinearity
-# (α·β·γ) but lie in separate basins of the least squares, so the refit descends from the best start of each
-LOOP_SHARES = {1.0: (0.03, DEFAULT_SHARE, 0.3, 0.6), 0.1: (0.3, 0.6), 0.01: (0.3, 0.6)}
+# δ scaled by 0.1 (every share) and by 0.01 (the larger shares: wide loops that barely saturate there, turning
+# over at 10^(1/ν) and 100^(1/ν) times the force β's scale refers to, a mostly elastic element with a little
+# hysteretic damping), and by 0.3 at the smaller shares (a weak element whose loop turns over within a few
+# times that force). A strong element with a wide loop and a weak one with a narrow loop share the first-order
+# nonlinearity (α·β·γ) but lie in separate basins of the least squares, so the refit descends from the best
+# start of each
+LOOP_SHARES = {1.0: (0.03, DEFAULT_SHARE, 0.3, 0.6), 0.3: (0.03, DEFAULT_SHARE),
+               0.1: (0.03, DEFAULT_SHARE, 0.3, 0.6), 0.01: (0.3, 0.6)}
 NARROW_FROM = 0.5  # |γ| + |δ| of a loop start from which it counts as narrow (the listed shapes: 1 to 2)
 
 

@@ -74,7 +74,7 @@ RESULTS = {
     "docs/results/bench_diagnose_time.md": ("results/bench/diagnose_time.md", "python bench/diagnose_time.py"),
     "docs/results/bench_fit_time.md": ("results/bench/fit_time.md", "python bench/fit_time.py"),
     "docs/results/campaign.md": ("results/campaign/summary.md",
-                                 "stockbridge diagnose --campaign 200 --campaign-seed 17 --calibrate "
+                                 "stockbridge diagnose --campaign 200 --campaign-seed 18 --calibrate "
                                  "--out results/campaign"),
     "docs/results/campaign_damper.md": ("results/campaign_damper/summary.md",
                                         "stockbridge diagnose --campaign 6 --model damper --out "
