@@ -98,7 +98,7 @@ def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, po
 
 # more than SCREEN_FROM starts (a loop's grid of shapes, widths and shares; a combination's members' starts) are
 # ranked first with the FMU's input grid at the sensor rate (upsample 1: under half the cost, and the starts in
-# nearly the same order: tests/test_start_screening.py), then the best SCREEN_KEPT of each basin (or of all, at
+# nearly the same order: tests/test_gap_loop_friction.py), then the best SCREEN_KEPT of each basin (or of all, at
 # least task.probes) again at task.upsample
 SCREEN_FROM = 40
 SCREEN_KEPT = 3
