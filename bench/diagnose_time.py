@@ -1,7 +1,7 @@
 """Wall time of a full gap diagnosis with the default budgets on 2 workers, per stage, measured in one run.
 
-The cases are the ones a test bench produces: three levels of 35 s linear sweeps sampled at 750 Hz
-(the SDOF: force sweeps, displacement recorded; the damper: constant-velocity clamp sweeps of the design
+The cases are the ones a test bench produces: three levels of 35 s linear sweeps sampled at the family's rate
+(500 Hz; the SDOF: force sweeps, displacement recorded; the damper: constant-velocity clamp sweeps of the design
 1.3 damper, clamp displacement only and both cable-end displacements recorded), with hysteresis withheld; and
 the damper with hysteresis and cubic springs withheld together (a pair: the forward selection's joint refits
 run too). Goals: SDOF <= 60 s, a damper case <= 180 s.
@@ -36,7 +36,8 @@ def main():
     earlier = report.path.read_text(encoding="utf-8").splitlines() if args.only and report.path.is_file() else []
     for case in CASES:
         model, withheld, style = CASES[case]
-        opening = f"{model} diagnosis (three 35 s sweeps at 750 Hz, {withheld.replace('+', ' + ')} withheld, "
+        opening = (f"{model} diagnosis (three 35 s sweeps sampled at {FAMILIES[model].fs:g} Hz, "
+                   f"{withheld.replace('+', ' + ')} withheld, ")
         if args.only and case != args.only:
             for line in earlier:  # kept as that run wrote it
                 if line.startswith(f"- {opening}"):

@@ -1,11 +1,12 @@
 """attribute.run_fit with many starts: they are ranked on the FMU's input grid at the sensor rate (upsample 1)
 first, and only the best of each basin is scored at the refit's upsample (that the two grids order the SDOF
-loop's starts alike: test_gap_loop_friction.py)."""
+loop's starts alike: test_gap_loop_friction.py); the best BASINS_ON basins' probes go on with the whole budget."""
 import types
 
 import numpy as np
 import pytest
 
+from pyfit.fit.optim.result import OptimResult
 from pyfit.gap import attribute
 
 
@@ -50,3 +51,31 @@ def test_many_starts_are_ranked_coarsely_and_the_best_of_each_basin_scored_finel
 
 def _half(values):
     return values["a"] < 0.5
+
+
+def test_a_slow_basin_that_probes_second_goes_on_and_wins(monkeypatch):
+    """Two basins of a parameter a: below 0.5 a steep one (misfit 5|a - 0.2|) whose descent covers the way to its
+    minimum at a = 0.2 only after 100 evaluations, above it a shallow one stuck at 0.3. After the probes (a third
+    of the 120 evaluations) the steep basin misfits more (0.6 against 0.3); going on with both, the refit ends at
+    its minimum."""
+
+    def misfit(a):
+        return 5.0 * abs(a - 0.2) if a < 0.5 else 0.3 + 0.1 * abs(a - 0.8)
+
+    def stacked(runner, records, params, upsample, lead_periods, pool=None, of=None):
+        return np.array([misfit(params["a"])])
+
+    def descent(residuals, x0, budget, margin):  # a fixed share of the way to the basin's minimum per evaluation
+        goal = 0.2 if x0[0] < 0.5 else 0.8
+        x = x0 + (goal - x0) * min(1.0, budget / 100)
+        return OptimResult(x, float(np.sum(residuals(x) ** 2)), budget, "budget", [], 0.0)
+
+    monkeypatch.setattr(attribute, "_stacked", stacked)
+    monkeypatch.setattr(attribute, "polish", descent)
+    monkeypatch.setattr(attribute, "FmuRunner", _NoRunner)
+    record = types.SimpleNamespace(level_value=1.0, periodic=True, outputs={"y": None}, weights={})
+    task = attribute.FitTask("x.fmu", (record,), {}, {"a": 1.0}, {"a": (0.0, 1.0)}, "e", 1, 120, 4,
+                             alternatives=({"a": 0.0},), basin=_half, continuation=False)
+    fit = attribute.run_fit(task)
+    assert misfit(0.0 + 0.2 * 40 / 100) == pytest.approx(0.6)  # the steep basin's probe: behind the shallow one
+    assert fit.params["a"] == pytest.approx(0.2) and fit.calibration_nrmse == pytest.approx(0.0, abs=1e-12)

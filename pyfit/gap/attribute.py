@@ -103,6 +103,10 @@ def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, po
 SCREEN_FROM = 40
 SCREEN_KEPT = 3
 BASIN_SHARE = 1 / 3  # of a refit's budget, for the probe of each basin before the best goes on
+# basins whose probes go on with the whole budget: a third of the way along, the probes rank the basins poorly (a
+# loop started at ν = 2 with the right share and shape can still misfit more there than a weaker loop at ν = 1, and
+# yet go on to the noise floor where the weaker one stops at twice it)
+BASINS_ON = 2
 # share of a parameter's range a least-squares start is moved off its bounds (optim.baselines.polish): an effect
 # strength started at zero whose value is far below 1 % of its range (a weak quadratic damping beside a strong
 # cubic spring) would otherwise start ten times too strong and end worse than zero
@@ -117,7 +121,7 @@ def run_fit(task: FitTask) -> Fit:
     quarter), then every record. Never worse than the best start: each stage and the last least squares keep
     the best point they evaluated. With task.basin the same from the best start of each basin (an SDOF loop
     has one at each ν, which sets the scale of β, and width: systems.sdof_loop_basin), each with BASIN_SHARE
-    of the budget first, then the best of them with the whole budget; without it, likewise from the
+    of the budget first, then the BASINS_ON best of them each with the whole budget; without it, likewise from the
     task.probes best starts and task.probed (a combination's starts lead to different local optima of its many
     parameters)."""
     t0 = time.perf_counter()
@@ -176,8 +180,8 @@ def run_fit(task: FitTask) -> Fit:
         return (result.x, result.error, n) if result.error <= e0 else (x0, e0, n)
 
     # from the best start; with task.basin, from the best start of each basin, else from the
-    # task.probes best starts, each descended with a share of the budget (BASIN_SHARE), then the best of them on
-    # with the whole budget
+    # task.probes best starts, each descended with a share of the budget (BASIN_SHARE), then the best of them (of
+    # the basins: the BASINS_ON best) on with the whole budget
     order = np.argsort(errors)
     best_x, error = candidates[order[0]], errors[order[0]]
     firsts = {}
@@ -187,14 +191,12 @@ def run_fit(task: FitTask) -> Fit:
     elif task.probes > 1 or task.probed:
         firsts = dict(enumerate(order[:task.probes]))
         firsts.update({f"probed {k}": k for k in forced if k not in firsts.values()})
-    if firsts:
-        for k in firsts.values():
-            x, e, n = descend(candidates[k], errors[k], max(1, int(task.budget * BASIN_SHARE)))
-            used += n
-            if e < error:
-                best_x, error = x, e
-    best_x, error, n = descend(best_x, error, task.budget)
-    used += n
+    probed = [descend(candidates[k], errors[k], max(1, int(task.budget * BASIN_SHARE))) for k in firsts.values()]
+    used += sum(n for _, _, n in probed)
+    ahead = sorted(probed, key=lambda end: end[1])[:BASINS_ON if task.basin else 1] or [(best_x, error, 0)]
+    ends = [descend(x, e, task.budget) for x, e, _ in ahead]  # the best probes (or start) on with the whole budget
+    used += sum(n for _, _, n in ends)
+    best_x, error, _ = min(ends, key=lambda end: end[1])
     best = params(best_x)
     if task.floor is not None:  # never worse than the nominal model (the effect at zero)
         floor = with_derived({**task.fixed, **task.floor}, task.derived)
