@@ -10,6 +10,9 @@ from pyfit.fit.optim.result import OptimResult
 from pyfit.gap import attribute
 
 
+_RECORD = types.SimpleNamespace(level_value=1.0, periodic=True, outputs={"y": None}, weights={})  # one periodic record
+
+
 class _NoRunner:
     def __init__(self, fmu):
         pass
@@ -33,8 +36,7 @@ def test_many_starts_are_ranked_coarsely_and_the_best_of_each_basin_scored_finel
     monkeypatch.setattr(attribute, "_stacked", stacked)
     monkeypatch.setattr(attribute, "FmuRunner", _NoRunner)
     grid = [{"a": a, "b": b} for a in np.linspace(0.0, 1.0, 9) for b in np.linspace(0.0, 1.0, 9)]  # 81 starts
-    record = types.SimpleNamespace(level_value=1.0, periodic=True, outputs={"y": None}, weights={})
-    task = attribute.FitTask("x.fmu", (record,), {}, {"a": 0.5, "b": 0.5}, {"a": (0.0, 1.0), "b": (0.0, 1.0)}, "e",
+    task = attribute.FitTask("x.fmu", (_RECORD,), {}, {"a": 0.5, "b": 0.5}, {"a": (0.0, 1.0), "b": (0.0, 1.0)}, "e",
                              2, 40, 4, alternatives=tuple(grid), basin=_half, continuation=False,
                              probed=({"a": 1.0, "b": 0.0},))
     fit = attribute.run_fit(task)
@@ -73,8 +75,7 @@ def test_a_slow_basin_that_probes_second_goes_on_and_wins(monkeypatch):
     monkeypatch.setattr(attribute, "_stacked", stacked)
     monkeypatch.setattr(attribute, "polish", descent)
     monkeypatch.setattr(attribute, "FmuRunner", _NoRunner)
-    record = types.SimpleNamespace(level_value=1.0, periodic=True, outputs={"y": None}, weights={})
-    task = attribute.FitTask("x.fmu", (record,), {}, {"a": 1.0}, {"a": (0.0, 1.0)}, "e", 1, 120, 4,
+    task = attribute.FitTask("x.fmu", (_RECORD,), {}, {"a": 1.0}, {"a": (0.0, 1.0)}, "e", 1, 120, 4,
                              alternatives=({"a": 0.0},), basin=_half, continuation=False)
     fit = attribute.run_fit(task)
     assert misfit(0.0 + 0.2 * 40 / 100) == pytest.approx(0.6)  # the steep basin's probe: behind the shallow one
