@@ -76,6 +76,9 @@ RESULTS = {
     "docs/results/campaign.md": ("results/campaign/summary.md",
                                  "stockbridge diagnose --campaign 200 --campaign-seed 18 --calibrate "
                                  "--out results/campaign"),
+    "docs/results/campaign_check.md": ("results/campaign_check/summary.md",
+                                       "stockbridge diagnose --campaign 100 --campaign-seed 19 --out "
+                                       "results/campaign_check"),
     "docs/results/campaign_damper.md": ("results/campaign_damper/summary.md",
                                         "stockbridge diagnose --campaign 6 --model damper --out "
                                         "results/campaign_damper"),
