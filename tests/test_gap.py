@@ -70,3 +70,20 @@ def test_a_pinned_refit_holds_the_given_values_and_tries_each_remaining_start_on
     assert held.fixed == {"m": 2.0, "k3": 5e8}
     assert held.start == {"k": 1e5, "c2": 0.0} and set(held.bounds) == {"k", "c2"}
     assert held.alternatives == ({}, {"c2": 2.0}) and held.log_scaled == ("c2",) and held.budget == 60
+
+
+def test_a_pair_with_a_loop_descends_from_each_loop_basin_and_so_does_the_loop_beside_a_held_partner():
+    """systems.combine carries the loop's basins (a weak loop beside a strong spring lies in another basin than
+    the loop alone); attribute.pinned keeps them while the loop's shape is fitted (the loop beside a held spring)
+    and drops them once it is held (the spring beside the held loop has no loop basins left)."""
+    from pyfit.gap.attribute import FitTask, pinned
+    from pyfit.gap.systems import SDOF_EFFECTS, combine, sdof_loop_basin
+
+    pair = combine([SDOF_EFFECTS["cubic_stiffness"], SDOF_EFFECTS["hysteresis"]])
+    assert pair.basin is sdof_loop_basin and combine([SDOF_EFFECTS["cubic_stiffness"],
+                                                      SDOF_EFFECTS["quadratic_damping"]]).basin is None
+    shape = {"gamma": 0.5, "delta": -1.5, "nu": 2.0}
+    task = FitTask("x.fmu", (), {"m": 2.0}, {"k": 1e5, "alpha": 1e4, "k3": 0.0, **shape},
+                   {n: (-10.0, 10.0) for n in ("k", "alpha", "k3", *shape)}, pair.name, 2, 120, 1, basin=pair.basin)
+    assert pinned(task, {"k3": 1e8}, 60).basin is sdof_loop_basin
+    assert pinned(task, {"alpha": 1e4, **shape}, 60).basin is None

@@ -32,6 +32,17 @@ def test_a_larger_model_is_kept_only_when_it_removes_half_the_misfit_left_above_
     assert selection.simpler_or_better((1, 0.0050), (2, 0.0045), 0.0052, cut) == 0
 
 
+def test_of_two_pairs_both_within_the_noise_the_one_with_fewer_parameters_is_kept():
+    """A campaign case (cubic spring with quadratic damping withheld, floor should the noise grow 0.0049): the true
+    pair (2 parameters) and a loop with quadratic damping (5) both leave 0.0052, within 1.2x that floor; the
+    leaner one is kept whichever misfits a hair less. Above the noise the lower misfit still decides."""
+    noise = selection.noise_level(0.0049, 1.2, 0.0)
+    assert noise == pytest.approx(0.00588)
+    assert selection.simpler_or_better((2, 0.00521), (2, 0.00518), 0.0049, 0.5, parameters=(2, 5), noise=noise) == 0
+    assert selection.simpler_or_better((2, 0.00518), (2, 0.00521), 0.0049, 0.5, parameters=(5, 2), noise=noise) == 1
+    assert selection.simpler_or_better((2, 0.0080), (2, 0.0070), 0.0049, 0.5, parameters=(2, 5), noise=noise) == 1
+
+
 def test_a_model_is_extended_only_while_its_misfit_is_a_significant_gap():
     """The forward selection goes on by the nominal's test (noise_factor 1.2, min_gap 0.005): a single effect that
     leaves 2.5x a floor of 0.0019 (less than min_gap above it) is not extended; one that leaves 2.9x a floor of

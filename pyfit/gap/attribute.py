@@ -215,9 +215,22 @@ def run_fit(task: FitTask) -> Fit:
                time.perf_counter() - t0)
 
 
+def _free_basin(basin, free: dict):
+    """`basin` when it reads only parameters in `free` (a loop's shape fitted beside a held partner), else None (a
+    loop held at its refit has no basins left to descend from)."""
+    if basin is None:
+        return None
+    try:
+        basin(free)
+    except KeyError:
+        return None
+    return basin
+
+
 def pinned(task: FitTask, values: dict, budget: int) -> FitTask:
     """`task` with the parameters of `values` held at those values (no longer fitted), its starts that then
-    coincide taken once, and `budget` evaluations from the best of them only (no probes): e.g. an effect refitted
+    coincide taken once, and `budget` evaluations from the best of them only (no probes; from each basin's best
+    when the basins' parameters are all still free: a loop refitted beside a held spring): e.g. an effect refitted
     beside the model it extends held at that model's refit, before the two are refitted together (that joint
     refit then probes from the best starts, this result among them)."""
     free = {n: v for n, v in task.start.items() if n not in values}
@@ -226,7 +239,7 @@ def pinned(task: FitTask, values: dict, budget: int) -> FitTask:
     return dataclasses.replace(task, fixed={**task.fixed, **values}, start=free,
                                bounds={n: task.bounds[n] for n in free}, alternatives=tuple(alternatives.values()),
                                log_scaled=tuple(n for n in task.log_scaled if n in free), budget=budget, probes=1,
-                               probed=())
+                               probed=(), basin=_free_basin(task.basin, free))
 
 
 STIFFNESS_SCAN = (0.25, 0.5, 1.0, 2.0, 4.0)  # factors on the nominal stiffness tried before the least squares

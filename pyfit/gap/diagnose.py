@@ -211,14 +211,16 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     can lead, the true first member come second): extend the model by each of the `cfg.partners` other effects
     whose sensitivity at that model explains most of its calibration residual (the screening repeated there;
     none when the model already meets the absolute criterion and no candidate explains
-    `cfg.min_partner_explained` of that residual: the path and the search end there). Each partner is refitted
+    `cfg.min_partner_explained` of that residual: the path ends there, and so does the search unless that model
+    holds a free-shape loop whose misfit is still above the noise, a possible stand-in). Each partner is refitted
     beside the model so far held at its own refit (attribute.pinned); the one that helps most there, the best of
     those with fewer parameters than it (selection.leaner_best: a free-shape loop absorbs most beside a held
     model), and the one that helps least (the control), are then refitted jointly (from each member's own refit,
     the effects' starts, the partner's refit beside the model and the members refitted beside the partner's
     refit; a combination reached from two paths is refitted beside each path's model, the better kept, and its
-    joint refit probes from its own path's refit beside too). Go on from the best combination when it removes `min_excess_cut` of the misfit above the floor that the model it extends
-    leaves once refitted on with a combination's budget (the combinations start from that refit and never end
+    joint refit probes from its own path's refit beside too). Go on from the best combination (the lowest misfit;
+    of two within the noise, the one with fewer parameters) when it removes `min_excess_cut` of the misfit above
+    the floor that the model it extends leaves once refitted on with a combination's budget (the combinations start from that refit and never end
     worse than it) or, when lower, the misfit of the control's joint refit (what the combination's extra
     evaluations alone buy the model it extends, counted with the control's partner at zero:
     selection.budget_control), up to `cfg.max_effects` members.
@@ -227,10 +229,11 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     A path's end is checked backward: the model without its last-added member is refitted from the end's
     values, and the end is kept only when it still removes `min_excess_cut` of what that refit leaves; an end
     still above the absolute criterion is then refitted on from its own values. A path whose start is a member
-    of an earlier path's end that explains the data is not tried. Of the ends of these paths, a larger model is
-    selected only by the same rule (selection.simpler_or_better). Adds the fits and held-out simulations to
-    `fits` and `sims`; returns the system with the combined effects among its effects and the model selected
-    (None when nothing was tried)."""
+    of an earlier path's end that explains the data (and is no possible stand-in) is not tried. Of the ends of
+    these paths, a larger model is selected only by the same rule, and of two as large whose misfits are both
+    within the noise, the one with fewer parameters (selection.simpler_or_better). Adds the fits and held-out
+    simulations to `fits` and `sims`; returns the system with the combined effects among its effects and the
+    model selected (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
     above = gap["noise_floor_scaled"]  # the noise the selection measures a misfit above (at least the floor)
     explained_below = selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin)
@@ -354,7 +357,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             for name in names:
                 if name not in after or name not in sims:
                     simulated(name)
-            best = min(names, key=lambda n: after[n], default=None)
+            best = functools.reduce(kept, names) if names else None  # the lowest misfit, or the leanest at the noise
             least = order[-1] if order else None
             tried = {n: (task, side) for n, task, _, side in new}
             control = selection.budget_control(without_partner(least, *tried[least]), len(names)) \
@@ -395,8 +398,13 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     def kept(a, b):  # of two path ends, the one a path would keep (selection.simpler_or_better)
         sized = [(len(effects[n].members or (n,)), after[n]) for n in (a, b)]
         larger = (a, b)[sized[1][0] > sized[0][0]]
-        return (a, b)[selection.simpler_or_better(*sized, above, cfg.min_excess_cut,
-                                                  controls.get(larger, float("inf")))]
+        return (a, b)[selection.simpler_or_better(
+            *sized, above, cfg.min_excess_cut, controls.get(larger, float("inf")),
+            parameters=(len(effects[a].params), len(effects[b].params)),
+            noise=selection.noise_level(above, cfg.noise_factor, cfg.combination_min_gap))]
+
+    def stand_in(name):  # a free-shape loop (one with basins) still above the noise: it may hold another's part
+        return effects[name].basin is not None and left(name)
 
     def polished(end):
         # a path's end still above the absolute criterion, refitted on from its own values with twice a refit's
@@ -408,11 +416,14 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
 
     ends = []
     for start in ranked[:cfg.beam]:
-        if any(after[e] <= explained_below and start in (effects[e].members or (e,)) for e in ends):
+        if any(after[e] <= explained_below and start in (effects[e].members or (e,)) and not stand_in(e)
+               for e in ends):
             break  # an earlier path's end explains the data and holds this start already
         ends.append(polished(grow(start)))
-        if not left(ends[-1]) or ends[-1] in settled:
+        if not left(ends[-1]) or (ends[-1] in settled and not stand_in(ends[-1])):
             break  # a path that reaches the noise, or explains the data with nothing a candidate explains left
+        # (not so a free-shape loop still above the noise: it can take up a strong spring's part beyond the reach
+        # of its sensitivity to the spring, where the path from the spring finds the weak loop beside it)
     selected = functools.reduce(kept, ends)
     return dataclasses.replace(system, effects=effects), selected
 

@@ -16,10 +16,15 @@ def heldout_nrmse(sims: dict, held) -> float:
     return float(np.sqrt(np.mean(np.square(done)))) if done and len(done) == len(held) else float("inf")
 
 
+def noise_level(floor: float, noise_factor: float, min_gap: float) -> float:
+    """The held-out NRMSE a model must exceed to leave a gap: max(noise_factor x the noise floor, floor + min_gap)."""
+    return max(noise_factor * floor, floor + min_gap)
+
+
 def significant(nrmse: float, floor: float, noise_factor: float, min_gap: float) -> bool:
-    """Whether a model's held-out misfit is a gap worth explaining: above noise_factor x the noise floor and
-    above the floor + min_gap (the nominal model's test, and the forward selection's test to go on)."""
-    return nrmse > max(noise_factor * floor, floor + min_gap)
+    """Whether a model's held-out misfit is a gap worth explaining: above noise_level (the nominal model's test,
+    and the forward selection's test to go on)."""
+    return nrmse > noise_level(floor, noise_factor, min_gap)
 
 
 def explained_below(floor: float, explain_factor: float, explain_margin: float) -> float:
@@ -67,11 +72,16 @@ def leaner_best(order: list[str], sizes: dict[str, int]) -> list[str]:
 
 
 def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, min_excess_cut: float,
-                      control: float = float("inf")) -> int:
+                      control: float = float("inf"), parameters: tuple[int, int] = (0, 0),
+                      noise: float = 0.0) -> int:
     """Of two models given as (number of effects, held-out NRMSE), the index (0: a, 1: b) of the one kept: of
-    two as large, the lower misfit; else the larger only when it adds enough (adds_enough) to the smaller one
-    credited with what refitting on alone buys it (the larger one's budget_control, when below its misfit)."""
+    two as large, the lower misfit, but the one with fewer `parameters` (each model's count) when both misfits
+    are at or below `noise` (noise_level: the data tell them apart no more); else the larger only when it adds
+    enough (adds_enough) to the smaller one credited with what refitting on alone buys it (the larger one's
+    budget_control, when below its misfit)."""
     if a[0] == b[0]:
+        if max(a[1], b[1]) <= noise and parameters[0] != parameters[1]:
+            return 0 if parameters[0] < parameters[1] else 1
         return 0 if a[1] <= b[1] else 1
     small, large = (0, 1) if a[0] < b[0] else (1, 0)
     pair = (a, b)

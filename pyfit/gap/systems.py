@@ -116,7 +116,9 @@ class System:
 
 
 def combine(effects: list[Effect]) -> Effect:
-    """Several effects at once: their parameters, fixed values and shape starts together (named 'a + b')."""
+    """Several effects at once: their parameters, fixed values and shape starts together (named 'a + b'); the
+    basins of a member that has them (a free-shape loop's: a weak loop beside a strong spring lies in another
+    basin than the loop alone, and its refit descends from each basin's best start as the loop's does)."""
     names = [e.name for e in effects]
     params, seen = [], set()
     for e in effects:
@@ -127,7 +129,8 @@ def combine(effects: list[Effect]) -> Effect:
                   signature="; ".join(f"{e.name}: {e.signature}" for e in effects),
                   shift_stiffness=max(e.shift_stiffness for e in effects),
                   starts=lambda s: [st for e in effects for st in e.starts(s)], members=tuple(names),
-                  derived=lambda s: tuple(r for e in effects for r in e.derived(s)))
+                  derived=lambda s: tuple(r for e in effects for r in e.derived(s)),
+                  basin=next((e.basin for e in effects if e.basin), None))
 
 
 def _sym(scale_fn):
