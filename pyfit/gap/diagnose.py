@@ -220,10 +220,10 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     refit; a combination reached from two paths is refitted beside each path's model, the better kept, and its
     joint refit probes from its own path's refit beside too). Go on from the best combination (the lowest misfit;
     of two within the noise, the one with fewer parameters) when it removes `min_excess_cut` of the misfit above
-    the floor that the model it extends leaves once refitted on with a combination's budget (the combinations start from that refit and never end
-    worse than it) or, when lower, the misfit of the control's joint refit (what the combination's extra
-    evaluations alone buy the model it extends, counted with the control's partner at zero:
-    selection.budget_control), up to `cfg.max_effects` members.
+    the floor that the model it extends leaves once refitted on with a combination's budget (the combinations
+    start from that refit and never end worse than it) or, when lower, the misfit of the control's joint refit
+    (what the combination's extra evaluations alone buy the model it extends, counted with the control's partner
+    at zero: selection.budget_control), up to `cfg.max_effects` members.
     The noise these tests measure a misfit above is the floor should the sensor noise grow with the level
     (gap["noise_floor_scaled"]): a floor taken too low asks a right pair to remove half of a misfit that is noise.
     A path's end is checked backward: the model without its last-added member is refitted from the end's
@@ -395,7 +395,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         return end if selection.adds_enough(min(after[rest], controls.get(end, float("inf"))), after[end], above,
                                             cfg.min_excess_cut) else rest
 
-    def kept(a, b):  # of two path ends, the one a path would keep (selection.simpler_or_better)
+    def kept(a, b):  # of two models (path ends, a path's combinations), the one kept (selection.simpler_or_better)
         sized = [(len(effects[n].members or (n,)), after[n]) for n in (a, b)]
         larger = (a, b)[sized[1][0] > sized[0][0]]
         return (a, b)[selection.simpler_or_better(
