@@ -36,6 +36,9 @@
 #define OFS_STATE (OFS_INPUT + N_INPUTS)
 #define OFS_DER (OFS_STATE + N_STATES)
 #define OFS_VAR (OFS_DER + N_STATES)
+#define DIRTY_DER 1
+#define DIRTY_VAR 2
+#define DIRTY_ALL (DIRTY_DER | DIRTY_VAR)
 #define N_TOTAL (OFS_VAR + N_VARS)
 #define N_XU (N_STATES + N_INPUTS)
 #define N_OUT (N_STATES + N_VARS) /* rows of the Jacobian: derivatives, then other variables */
@@ -63,7 +66,7 @@ typedef struct {
   double du2[ARRSZ(N_INPUTS)];
   double time;
   double rtol;
-  int dirty;
+  int dirty; /* DIRTY_DER | DIRTY_VAR: the state derivatives, the variables are stale */
   int params_dirty; /* a parameter changed: calculated parameters, variant and hoisted values are stale */
   ModelFunction ode, vars, jac;
   double hoist[ARRSZ(N_HOIST)];
@@ -159,16 +162,22 @@ static int finite_all(const double *a, int n) {
   return 1;
 }
 
-static fmi2Status update_all(Instance *c) {
+/* the stale ones of `need` (DIRTY_DER: the state derivatives, DIRTY_VAR: the variables) at the current time,
+   state and inputs; each is computed only when read (an output read between steps needs no derivatives) */
+static fmi2Status update(Instance *c, int need) {
   double t = c->time;
-  if (!c->dirty) return fmi2OK;
+  need &= c->dirty;
+  if (!need) return fmi2OK;
   if (update_calculated(c)) return fmi2Error;
-  if (call_ode(c, c->v + OFS_STATE, c->v + OFS_INPUT, c->time, c->v + OFS_DER)) return fmi2Error;
+  if ((need & DIRTY_DER) &&
+      call_ode(c, c->v + OFS_STATE, c->v + OFS_INPUT, c->time, c->v + OFS_DER)) return fmi2Error;
 #if N_VARS > 0
-  if (call_model(c, c->vars, c->v + OFS_STATE, c->v + OFS_INPUT, &t, c->v + OFS_VAR)) return fmi2Error;
+  if ((need & DIRTY_VAR) &&
+      call_model(c, c->vars, c->v + OFS_STATE, c->v + OFS_INPUT, &t, c->v + OFS_VAR)) return fmi2Error;
 #endif
-  c->dirty = 0;
-  if (!finite_all(c->v + OFS_DER, N_STATES) || !finite_all(c->v + OFS_VAR, N_VARS)) {
+  c->dirty &= ~need;
+  if (((need & DIRTY_DER) && !finite_all(c->v + OFS_DER, N_STATES)) ||
+      ((need & DIRTY_VAR) && !finite_all(c->v + OFS_VAR, N_VARS))) {
     logmsg(c, fmi2Error, "non-finite state derivative or variable at t = %g: the simulation diverged%s", c->time,
            c->type == fmi2ModelExchange ? " (with Model Exchange: an explicit solver such as forward Euler diverges "
                                           "at a step above about 2*zeta/omega of the fastest mode; use a smaller "
@@ -178,6 +187,8 @@ static fmi2Status update_all(Instance *c) {
   }
   return fmi2OK;
 }
+
+static fmi2Status update_all(Instance *c) { return update(c, DIRTY_ALL); }
 
 /* ---- FMI common functions ------------------------------------------------------------------- */
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
@@ -195,7 +206,7 @@ static void reset_values(Instance *c) {
   memset(c->du2, 0, sizeof c->du2);
   c->time = 0.0;
   c->rtol = 1e-8;
-  c->dirty = 1;
+  c->dirty = DIRTY_ALL;
   c->params_dirty = 1;
   c->h_last = 0.0;
   c->state = ST_INSTANTIATED;
@@ -270,7 +281,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component comp, fmi2Boolean tolDefined, fmi2R
   GUARD(IN(ST_INSTANTIATED), 0, "fmi2SetupExperiment");
   if (tolDefined && tol > 0) c->rtol = tol;
   c->time = t0;
-  c->dirty = 1;
+  c->dirty = DIRTY_ALL;
   return fmi2OK;
 }
 
@@ -278,7 +289,7 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component comp) {
   Instance *c = (Instance *)comp;
   GUARD(IN(ST_INSTANTIATED), 0, "fmi2EnterInitializationMode");
   c->state = ST_INIT;
-  c->dirty = 1;
+  c->dirty = DIRTY_ALL;
   c->params_dirty = 1;
   return update_calculated(c) ? fmi2Error : fmi2OK;
 }
@@ -288,7 +299,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component comp) {
   int i;
   fmi2Status st;
   GUARD(IN(ST_INIT), 0, "fmi2ExitInitializationMode");
-  c->dirty = 1;
+  c->dirty = DIRTY_ALL;
   st = update_all(c);
   if (st != fmi2OK) { c->state = ST_ERROR; return st; }
   for (i = 0; i < N_STATES; i++) c->xscale[i] = fabs(c->v[OFS_STATE + i]);
@@ -323,8 +334,10 @@ static fmi2Status check_vr(Instance *c, fmi2ValueReference vr, int type) {
 
 static fmi2Status get_values(Instance *c, const fmi2ValueReference vr[], size_t n, double *out, int type) {
   size_t i;
+  int need = DIRTY_VAR;
   GUARD(ANY_BUT_ERROR, 0, "fmi2Get<Type>");
-  if (c->state != ST_INSTANTIATED && update_all(c) != fmi2OK) {
+  for (i = 0; i < n; i++) if (vr[i] >= OFS_DER && vr[i] < OFS_VAR) need = DIRTY_ALL;
+  if (c->state != ST_INSTANTIATED && update(c, need) != fmi2OK) {
     for (i = 0; i < n; i++) if (vr[i] < N_TOTAL) out[i] = c->v[vr[i]];
     return fmi2Error;
   }
@@ -349,7 +362,7 @@ static fmi2Status set_values(Instance *c, const fmi2ValueReference vr[], size_t 
     c->v[vr[i]] = in[i];
     if (kind == 1) c->params_dirty = 1;
   }
-  c->dirty = 1;
+  c->dirty = DIRTY_ALL;
   return fmi2OK;
 }
 
@@ -454,7 +467,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component comp, fmi2FMUstate s) {
   c->rtol = sn->rtol;
   c->h_last = sn->h_last;
   c->state = sn->state;
-  c->dirty = 1;
+  c->dirty = DIRTY_ALL;
   c->params_dirty = 1;
   return fmi2OK;
 }
@@ -562,7 +575,7 @@ fmi2Status fmi2SetTime(fmi2Component comp, fmi2Real time) {
   Instance *c = (Instance *)comp;
   GUARD(IN(ST_EVENT) | IN(ST_CONT), ME_ONLY, "fmi2SetTime");
   c->time = time;
-  c->dirty = 1;
+  c->dirty = DIRTY_ALL;
   return fmi2OK;
 }
 
@@ -571,7 +584,7 @@ fmi2Status fmi2SetContinuousStates(fmi2Component comp, const fmi2Real x[], size_
   GUARD(IN(ST_EVENT) | IN(ST_CONT), ME_ONLY, "fmi2SetContinuousStates");
   if (nx != N_STATES) return fmi2Error;
   memcpy(c->v + OFS_STATE, x, sizeof(double) * nx);
-  c->dirty = 1;
+  c->dirty = DIRTY_ALL;
   return fmi2OK;
 }
 
@@ -734,8 +747,10 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real tc, fmi2Real H, fmi2Boolean n
   memcpy(c->v + OFS_INPUT, inputs_at(c, u0, H), sizeof(double) * N_INPUTS);
   memset(c->du1, 0, sizeof c->du1);
   memset(c->du2, 0, sizeof c->du2);
-  c->dirty = 1;
-  if (fail || update_all(c) != fmi2OK) {
+  /* the derivatives and variables at the new time are computed when they are read (update_all): a driver
+     that sets the next inputs first would otherwise pay for them twice; a diverged state fails here */
+  c->dirty = DIRTY_ALL;
+  if (fail || !finite_all(x, N_STATES)) {
     logmsg(c, fmi2Error, "integration failed in the step from t = %g (diverged or too stiff)", tc);
     c->state = ST_ERROR;
     return fmi2Error;
