@@ -188,8 +188,6 @@ static fmi2Status update(Instance *c, int need) {
   return fmi2OK;
 }
 
-static fmi2Status update_all(Instance *c) { return update(c, DIRTY_ALL); }
-
 /* ---- FMI common functions ------------------------------------------------------------------- */
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 const char *fmi2GetVersion(void) { return fmi2Version; }
@@ -300,7 +298,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component comp) {
   fmi2Status st;
   GUARD(IN(ST_INIT), 0, "fmi2ExitInitializationMode");
   c->dirty = DIRTY_ALL;
-  st = update_all(c);
+  st = update(c, DIRTY_ALL);
   if (st != fmi2OK) { c->state = ST_ERROR; return st; }
   for (i = 0; i < N_STATES; i++) c->xscale[i] = fabs(c->v[OFS_STATE + i]);
   c->state = (c->type == fmi2CoSimulation) ? ST_STEP : ST_EVENT;
@@ -593,7 +591,7 @@ fmi2Status fmi2GetDerivatives(fmi2Component comp, fmi2Real dx[], size_t nx) {
   fmi2Status st;
   GUARD(IN(ST_INIT) | IN(ST_EVENT) | IN(ST_CONT) | IN(ST_TERMINATED), ME_ONLY, "fmi2GetDerivatives");
   if (nx != N_STATES) return fmi2Error;
-  st = update_all(c);
+  st = update(c, DIRTY_DER); /* a solver's right-hand side: no variables */
   memcpy(dx, c->v + OFS_DER, sizeof(double) * nx);
   return st;
 }
@@ -747,7 +745,7 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real tc, fmi2Real H, fmi2Boolean n
   memcpy(c->v + OFS_INPUT, inputs_at(c, u0, H), sizeof(double) * N_INPUTS);
   memset(c->du1, 0, sizeof c->du1);
   memset(c->du2, 0, sizeof c->du2);
-  /* the derivatives and variables at the new time are computed when they are read (update_all): a driver
+  /* the derivatives and variables at the new time are computed when they are read (update): a driver
      that sets the next inputs first would otherwise pay for them twice; a diverged state fails here */
   c->dirty = DIRTY_ALL;
   if (fail || !finite_all(x, N_STATES)) {
