@@ -40,6 +40,24 @@ def test_interrupted_diagnosis_resumes_from_finished_refits(data_root, fmu_dir, 
             assert after[r["effect"]] == pytest.approx(r["shrink_pct"], abs=1e-9)
 
 
+def test_a_refit_is_the_same_on_one_thread_as_on_two(data_root, fmu_dir):
+    """A fit simulating its calibration records on two threads (one FMU instance each; every fit of a
+    diagnosis on several cores may) ends at exactly the parameters and misfit it reaches on one."""
+    from pyfit.gap.attribute import nominal_task
+    from pyfit.gap.systems import family_fmu, make_system
+    from pyfit.runtime.fmu import FmuRunner
+
+    fmu = str(fmu_dir / f"{family_fmu('sdof')}.fmu")
+    runner = FmuRunner(fmu)
+    system = make_system("sdof", dg.fmu_defaults(runner), None)
+    _, cal, _, _, _ = dg._load(case(data_root, "cubic_stiffness"), system, CI, runner)
+    runner.close()
+    assert len(cal) >= 2  # two records to simulate at once
+    one, two = (dg.run_fit(nominal_task(system, fmu, cal, 12, CI.upsample, threads=n)) for n in (1, 2))
+    assert one.params == two.params and one.calibration_nrmse == two.calibration_nrmse
+    assert one.evaluations == two.evaluations > 1
+
+
 def test_close_runner_up_gets_a_level_and_band_to_measure(data_root, fmu_dir):
     # reuse the stored refits of the quadratic-damping case; call every runner-up close (close_points 100)
     out = diagnosed(data_root, fmu_dir, "quadratic_damping")

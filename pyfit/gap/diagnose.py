@@ -161,16 +161,22 @@ def _stored(path: pathlib.Path, key: str) -> Fit | None:
 
 def _fits_of(jobs, key: str, alone: int, workers, progress: bool, desc: str) -> dict[str, Fit]:
     """The fits of `jobs` ((task, path, *stages): see _fit_and_store) by their effect's name: each stored one read
-    from its path, the others run (in workers), each simulating its records on alone // (fits run) threads when
-    fewer fits than cores run."""
+    from its path, the others run (in workers: _run_fits)."""
     done = {job[0].effect: _stored(pathlib.Path(job[1]), key) for job in jobs}
-    todo = [job for job in jobs if done[job[0].effect] is None]
-    threads = max(1, alone // max(1, len(todo)))
-    todo = [(dataclasses.replace(task, threads=threads), str(path), key,
-             *(dataclasses.replace(stage, threads=threads) for stage in stages)) for task, path, *stages in todo]
-    for fit in map_tasks(_fit_and_store, todo, workers=workers, progress=progress, desc=desc):
+    todo = [(task, str(path), key, *stages) for task, path, *stages in jobs if done[task.effect] is None]
+    for fit in _run_fits(todo, alone, workers, progress, desc):
         done[fit.effect] = fit
     return done
+
+
+def _run_fits(jobs, alone: int, workers, progress: bool, desc: str) -> list[Fit]:
+    """_fit_and_store of each job (task, path, key, *stages) in workers, each fit simulating its records on up to
+    `alone` threads (the cores a fit running alone has): the fits that run while others end take up the cores
+    those leave idle (three fits on two cores, or one long refit behind short ones, no longer end on one core).
+    A fit's result does not depend on its threads."""
+    jobs = [(dataclasses.replace(task, threads=alone), path, key,
+             *(dataclasses.replace(stage, threads=alone) for stage in stages)) for task, path, key, *stages in jobs]
+    return map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc=desc)
 
 
 def _stem(name: str) -> str:
@@ -547,7 +553,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
                 jobs.append((effect_task(system, system.effects[name], fmu, cal, nominal, scale, cfg.refit_budget,
                                          cfg.upsample, strengths.get(name), linear_starts), str(path), key))
         jobs.sort(key=lambda job: job[0].basin is None)  # the longest (a refit from each basin) first
-        for fit in map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc="refits"):
+        for fit in _run_fits(jobs, workers or os.cpu_count() or 1, workers, progress, "refits"):
             fits[fit.effect] = fit
         for name, f in fits.items():  # an effect is judged on the held-out files only
             sims[name] = {r.name: sim.simulate(runner, r, f.params, cfg.upsample, system.lead_periods)
