@@ -9,6 +9,8 @@ model error of several per cent).
 """
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 from pyfit.analysis.signals import periodic_drive, upsample_spline
@@ -37,6 +39,35 @@ def fine_inputs(inputs: dict[str, np.ndarray], upsample: int, samples_per_period
     return {k: upsample_spline(np.asarray(v, float), q) for k, v in inputs.items()}, 0
 
 
+# fine_inputs of the last MEMO_SIZE distinct inputs of this process: a fit drives the same few records hundreds
+# of times, and upsampling them is a few per cent of a simulation
+MEMO_SIZE = 8
+_memo: list = []  # (key, the inputs as they were, the result), newest last
+_memo_lock = threading.Lock()
+
+
+def remembered_fine_inputs(inputs: dict[str, np.ndarray], upsample: int, samples_per_period: int | None = None,
+                           lead_periods: int = 0) -> tuple[dict[str, np.ndarray], int]:
+    """fine_inputs, computed once for inputs equal in value to ones this process upsampled among the last
+    MEMO_SIZE (an input changed in place is upsampled anew); the arrays returned are shared between calls: read
+    them only."""
+    key = (int(upsample), samples_per_period or 0, lead_periods, tuple(inputs))
+    arrays = {k: np.asarray(v, float) for k, v in inputs.items()}
+
+    def same(kept):
+        return all(kept[k].shape == v.shape and np.array_equal(kept[k], v) for k, v in arrays.items())
+
+    with _memo_lock:
+        for entry in _memo:
+            if entry[0] == key and same(entry[1]):
+                return entry[2]
+    fine, skip = fine_inputs(arrays, upsample, samples_per_period, lead_periods)
+    with _memo_lock:
+        _memo.append((key, {k: v.copy() for k, v in arrays.items()}, (fine, skip)))
+        del _memo[:-MEMO_SIZE]
+    return fine, skip
+
+
 def drive(runner: FmuRunner, inputs: dict[str, np.ndarray], fs: float, outputs: list[str], params: dict,
           upsample: int = 4, samples_per_period: int | None = None, lead_periods: int = 0,
           tolerance: float = 1e-8, max_wall_s: float | None = None) -> SimulationResult:
@@ -46,7 +77,7 @@ def drive(runner: FmuRunner, inputs: dict[str, np.ndarray], fs: float, outputs: 
     that fails, returns a non-finite value or takes longer than max_wall_s seconds gives ok=False with the
     reason (never an exception)."""
     n = len(next(iter(inputs.values())))
-    fine, skip = fine_inputs(inputs, upsample, samples_per_period, lead_periods)
+    fine, skip = remembered_fine_inputs(inputs, upsample, samples_per_period, lead_periods)
     n_fine = len(next(iter(fine.values())))
     dt = 1.0 / (fs * upsample)
     t = np.arange(n_fine) * dt
