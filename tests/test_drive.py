@@ -38,3 +38,42 @@ def test_remembered_upsampling_equals_a_fresh_one_and_an_input_changed_in_place_
     assert changed is not remembered[None]
     assert np.array_equal(changed["u"], drive.fine_inputs(inputs, 4)[0]["u"])
     assert np.abs(changed["u"] - remembered[None]["u"]).max() > 0.5
+
+
+def test_the_memory_forgets_the_least_recently_used_beyond_its_bytes():
+    from pyfit.runtime.memo import BoundedMemo, digest
+
+    memo = BoundedMemo(max_bytes=3000)
+    for k in "abc":
+        memo.put(k, k.upper(), 1000)
+    assert memo.get("a") == "A"  # used: now the most recent
+    memo.put("d", "D", 1000)  # 4000 bytes: the least recently used ("b") goes
+    assert [memo.get(k) for k in "abcd"] == ["A", None, "C", "D"]
+    memo.put("huge", "H", 3001)  # larger than the whole memory: not kept, nothing forgotten for it
+    assert memo.get("huge") is None and memo.get("c") == "C"
+    # keys: by value and exact bits (-0.0 and 0.0 run an FMU apart; an array's dtype and shape count)
+    assert digest({"k": 1.0}, np.arange(3.0)) == digest({"k": 1.0}, np.arange(3.0))
+    assert digest(0.0) != digest(-0.0) and digest(np.zeros(4)) != digest(np.zeros((2, 2)))
+
+
+def test_a_run_made_before_is_returned_not_made_again_and_a_failed_one_is_made_again(runner, monkeypatch):
+    from pyfit.runtime.fmu import FmuRunner
+
+    sdof = runner("SDOFBoucWen")
+    runs = []
+    real = FmuRunner.simulate
+    monkeypatch.setattr(FmuRunner, "simulate", lambda self, *a, **k: runs.append(1) or real(self, *a, **k))
+    u = {"u": 20.0 * np.sin(2 * np.pi * 30.0 * np.arange(500) / 500.0)}
+    params = {"exc_type": 0, "alpha": 0.0, "k3": 2.5e8}
+    first = drive.drive(sdof, u, 500.0, ["y"], params)
+    again = drive.drive(sdof, {"u": u["u"].copy()}, 500.0, ["y"], dict(reversed(list(params.items()))))
+    assert len(runs) == 1 and np.array_equal(first["y"], again["y"])
+    again["y"][:] = 0.0  # a copy: what the memory holds is unchanged
+    assert np.array_equal(drive.drive(sdof, u, 500.0, ["y"], params)["y"], first["y"]) and len(runs) == 1
+    other = drive.drive(sdof, u, 500.0, ["y"], {**params, "k3": 2.6e8})  # another parameter set: run
+    assert len(runs) == 2 and not np.array_equal(other["y"], first["y"])
+    # a softening spring past its escape deflection (sqrt(k / |k3|) = 3e-5 m; the static one is 2e-4 m)
+    # diverges: a failure, made again each time (never remembered)
+    bad = {**params, "k3": -1e14}
+    assert not drive.drive(sdof, u, 500.0, ["y"], bad).ok and not drive.drive(sdof, u, 500.0, ["y"], bad).ok
+    assert len(runs) == 4

@@ -9,12 +9,13 @@ model error of several per cent).
 """
 from __future__ import annotations
 
-import threading
+import pathlib
 
 import numpy as np
 
 from pyfit.analysis.signals import periodic_drive, upsample_spline
 from pyfit.runtime.fmu import FmuRunner, SimulationResult
+from pyfit.runtime.memo import BoundedMemo, digest
 
 
 def fine_inputs(inputs: dict[str, np.ndarray], upsample: int, samples_per_period: int | None = None,
@@ -39,33 +40,24 @@ def fine_inputs(inputs: dict[str, np.ndarray], upsample: int, samples_per_period
     return {k: upsample_spline(np.asarray(v, float), q) for k, v in inputs.items()}, 0
 
 
-# fine_inputs of the last MEMO_SIZE distinct inputs of this process: a fit drives the same few records hundreds
-# of times, and upsampling them is a few per cent of a simulation
-MEMO_SIZE = 8
-_memo: list = []  # (key, the inputs as they were, the result), newest last
-_memo_lock = threading.Lock()
+# what a process remembers (pyfit.runtime.memo): inputs upsampled for the FMU (a fit drives the same few records
+# hundreds of times; upsampling one is a few per cent of its simulation) and responses (a fit evaluates many
+# parameter sets more than once)
+FINE_MEMO = BoundedMemo(64 * 2**20)
+RESPONSE_MEMO = BoundedMemo(256 * 2**20)
 
 
 def remembered_fine_inputs(inputs: dict[str, np.ndarray], upsample: int, samples_per_period: int | None = None,
                            lead_periods: int = 0) -> tuple[dict[str, np.ndarray], int]:
-    """fine_inputs, computed once for inputs equal in value to ones this process upsampled among the last
-    MEMO_SIZE (an input changed in place is upsampled anew); the arrays returned are shared between calls: read
-    them only."""
-    key = (int(upsample), samples_per_period or 0, lead_periods, tuple(inputs))
+    """fine_inputs, computed once for inputs equal in value to ones this process upsampled lately (an input
+    changed in place is upsampled anew); the arrays returned are shared between calls: read them only."""
     arrays = {k: np.asarray(v, float) for k, v in inputs.items()}
-
-    def same(kept):
-        return all(kept[k].shape == v.shape and np.array_equal(kept[k], v) for k, v in arrays.items())
-
-    with _memo_lock:
-        for entry in _memo:
-            if entry[0] == key and same(entry[1]):
-                return entry[2]
-    fine, skip = fine_inputs(arrays, upsample, samples_per_period, lead_periods)
-    with _memo_lock:
-        _memo.append((key, {k: v.copy() for k, v in arrays.items()}, (fine, skip)))
-        del _memo[:-MEMO_SIZE]
-    return fine, skip
+    key = digest(arrays, int(upsample), samples_per_period or 0, lead_periods)
+    found = FINE_MEMO.get(key)
+    if found is None:
+        found = fine_inputs(arrays, upsample, samples_per_period, lead_periods)
+        FINE_MEMO.put(key, found, sum(v.nbytes for v in found[0].values()))
+    return found
 
 
 def drive(runner: FmuRunner, inputs: dict[str, np.ndarray], fs: float, outputs: list[str], params: dict,
@@ -75,7 +67,27 @@ def drive(runner: FmuRunner, inputs: dict[str, np.ndarray], fs: float, outputs: 
 
     Returns the outputs at the record's own samples (t = 0, 1/fs, ...), as many as the inputs have; a run
     that fails, returns a non-finite value or takes longer than max_wall_s seconds gives ok=False with the
-    reason (never an exception)."""
+    reason (never an exception). A successful run this process made with the same FMU file, inputs, parameters
+    and settings is not made again: its outputs are returned (copies; the same values to the bit)."""
+    file = pathlib.Path(runner.path).stat()
+    key = digest(runner.path, runner.interface, file.st_mtime_ns, file.st_size, {k: np.asarray(v, float) for k, v
+                 in inputs.items()}, fs, list(outputs), sorted(params.items()), int(upsample), samples_per_period or 0,
+                 lead_periods, tolerance)
+    known = RESPONSE_MEMO.get(key)
+    if known is not None:
+        return SimulationResult(known.time.copy(), {k: v.copy() for k, v in known.values.items()})
+    res = _driven(runner, inputs, fs, outputs, params, upsample, samples_per_period, lead_periods, tolerance,
+                  max_wall_s)
+    if res.ok:  # kept compact (the outputs are strided views of the FMU's finer grid)
+        kept = SimulationResult(res.time.copy(), {k: v.copy() for k, v in res.values.items()})
+        RESPONSE_MEMO.put(key, kept, kept.time.nbytes + sum(v.nbytes for v in kept.values.values()))
+    return res
+
+
+def _driven(runner: FmuRunner, inputs: dict[str, np.ndarray], fs: float, outputs: list[str], params: dict,
+            upsample: int, samples_per_period: int | None, lead_periods: int, tolerance: float,
+            max_wall_s: float | None) -> SimulationResult:
+    """drive's run of the FMU (nothing remembered)."""
     n = len(next(iter(inputs.values())))
     fine, skip = remembered_fine_inputs(inputs, upsample, samples_per_period, lead_periods)
     n_fine = len(next(iter(fine.values())))
