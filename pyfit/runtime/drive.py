@@ -48,11 +48,12 @@ RESPONSE_MEMO = BoundedMemo(256 * 2**20)
 
 
 def remembered_fine_inputs(inputs: dict[str, np.ndarray], upsample: int, samples_per_period: int | None = None,
-                           lead_periods: int = 0) -> tuple[dict[str, np.ndarray], int]:
+                           lead_periods: int = 0, source: str | None = None) -> tuple[dict[str, np.ndarray], int]:
     """fine_inputs, computed once for inputs equal in value to ones this process upsampled lately (an input
-    changed in place is upsampled anew); the arrays returned are shared between calls: read them only."""
+    changed in place is upsampled anew); the arrays returned are shared between calls: read them only.
+    source: digest(inputs as float arrays), when the caller has it already."""
     arrays = {k: np.asarray(v, float) for k, v in inputs.items()}
-    key = digest(arrays, int(upsample), samples_per_period or 0, lead_periods)
+    key = digest(source or digest(arrays), int(upsample), samples_per_period or 0, lead_periods)
     found = FINE_MEMO.get(key)
     if found is None:
         found = fine_inputs(arrays, upsample, samples_per_period, lead_periods)
@@ -70,14 +71,14 @@ def drive(runner: FmuRunner, inputs: dict[str, np.ndarray], fs: float, outputs: 
     reason (never an exception). A successful run this process made with the same FMU file, inputs, parameters
     and settings is not made again: its outputs are returned (copies; the same values to the bit)."""
     file = pathlib.Path(runner.path).stat()
-    key = digest(runner.path, runner.interface, file.st_mtime_ns, file.st_size, {k: np.asarray(v, float) for k, v
-                 in inputs.items()}, fs, list(outputs), sorted(params.items()), int(upsample), samples_per_period or 0,
-                 lead_periods, tolerance)
+    source = digest({k: np.asarray(v, float) for k, v in inputs.items()})  # hashed once per run
+    key = digest(runner.path, runner.interface, file.st_mtime_ns, file.st_size, source, fs, list(outputs),
+                 sorted(params.items()), int(upsample), samples_per_period or 0, lead_periods, tolerance)
     known = RESPONSE_MEMO.get(key)
     if known is not None:
         return SimulationResult(known.time.copy(), {k: v.copy() for k, v in known.values.items()})
     res = _driven(runner, inputs, fs, outputs, params, upsample, samples_per_period, lead_periods, tolerance,
-                  max_wall_s)
+                  max_wall_s, source)
     if res.ok:  # kept compact (the outputs are strided views of the FMU's finer grid)
         kept = SimulationResult(res.time.copy(), {k: v.copy() for k, v in res.values.items()})
         RESPONSE_MEMO.put(key, kept, kept.time.nbytes + sum(v.nbytes for v in kept.values.values()))
@@ -86,10 +87,10 @@ def drive(runner: FmuRunner, inputs: dict[str, np.ndarray], fs: float, outputs: 
 
 def _driven(runner: FmuRunner, inputs: dict[str, np.ndarray], fs: float, outputs: list[str], params: dict,
             upsample: int, samples_per_period: int | None, lead_periods: int, tolerance: float,
-            max_wall_s: float | None) -> SimulationResult:
-    """drive's run of the FMU (nothing remembered)."""
+            max_wall_s: float | None, source: str) -> SimulationResult:
+    """drive's run of the FMU (no response remembered; source: the inputs' digest)."""
     n = len(next(iter(inputs.values())))
-    fine, skip = remembered_fine_inputs(inputs, upsample, samples_per_period, lead_periods)
+    fine, skip = remembered_fine_inputs(inputs, upsample, samples_per_period, lead_periods, source)
     n_fine = len(next(iter(fine.values())))
     dt = 1.0 / (fs * upsample)
     t = np.arange(n_fine) * dt
