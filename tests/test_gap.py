@@ -55,7 +55,7 @@ def test_a_refit_is_the_same_on_one_thread_as_on_two(data_root, fmu_dir, monkeyp
     fmu = str(fmu_dir / f"{family_fmu('sdof')}.fmu")
     runner = FmuRunner(fmu)
     system = make_system("sdof", dg.fmu_defaults(runner), None)
-    _, cal, _, _, _ = dg._load(case(data_root, "cubic_stiffness"), system, CI, runner)
+    _, cal, _, _, _, _ = dg._load(case(data_root, "cubic_stiffness"), system, CI, runner)
     runner.close()
     assert len(cal) >= 2  # two records to simulate at once
     one, two = (dg.run_fit(nominal_task(system, fmu, cal, 12, CI.upsample, threads=n)) for n in (1, 2))

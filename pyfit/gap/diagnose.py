@@ -22,7 +22,7 @@ from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read
 from pyfit.gap import confidence, localise, selection, user_candidates
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, nominal_task, pinned, run_fit, screen
-from pyfit.gap.systems import combine, family_fmu, make_system
+from pyfit.gap.systems import combine, family_fmu, make_system, strength_grid
 from pyfit.io.nominal import NominalModel, load_nominal
 
 
@@ -56,11 +56,13 @@ class DiagnoseConfig:
     combination_min_gap: float = 0.0  # NRMSE a model's held-out misfit must exceed beyond the floor to add a member
     min_partner_explained: float = 0.005  # a model meeting the absolute criterion is extended only when a
     # candidate's sensitivity explains this share of its calibration residual (the screening at that model)
+    grid_models: int = 3  # when no model meets the absolute criterion: the best ones by held-out misfit, each
+    # refitted from the best point of a grid over its members' strengths (systems.strength_grid)
 
 
 _SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
                    int if f.name in ("nominal_budget", "refit_budget", "upsample", "max_effects", "partners",
-                                 "combination_probes")
+                                 "combination_probes", "grid_models")
                    else "number"), False, f.default)
          for f in fields(DiagnoseConfig)}
 
@@ -79,7 +81,8 @@ def load_config(path) -> DiagnoseConfig:
 
 def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
     """Records of the dataset, validated against the FMU's variables, split into calibration and held-out; the
-    data's digest and what the level order rests on (pyfit.io.data.level_order)."""
+    data's digest, what the level order rests on (pyfit.io.data.level_order) and the records the default split
+    set aside (localise.unsettled: name -> its period scatter and the lowest noise floor of a lower level)."""
     data_dir = pathlib.Path(data_dir)
     md_vars = runner.model_description.modelVariables
     variables = {v.name for v in md_vars}
@@ -117,6 +120,14 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
                 raise DiagnoseError(f"{m.path.with_suffix('.toml')}: [{kind}] model_variable '{bad[0]}' is not a "
                                     f"variable of {system.fmu}; allowed: {', '.join(sorted(allowed[kind]))}")
     names = [r.name for r in records]
+    # the default split leaves out a record whose response does not repeat between periods (no steady state:
+    # a simulation cannot follow it sample by sample, and calibrating on it pulls every parameter off)
+    aside = {} if cfg.calibration else localise.unsettled(records)
+    if len(records) - len(aside) < 2:
+        raise DiagnoseError(f"{data_dir}: the response of {', '.join(aside)} does not repeat from one period to the "
+                            "next (no steady state), which leaves fewer than two files to calibrate on and hold "
+                            "out; allowed: name the files to calibrate on in [diagnose] calibration to use them all")
+    records = [r for r in records if r.name not in aside]
     if cfg.calibration:
         bad = [c for c in cfg.calibration if c not in names]
         if bad:
@@ -133,7 +144,7 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
     for m in ms:
         digest.update(m.path.read_bytes())
         digest.update(m.path.with_suffix(".toml").read_bytes())
-    return records, cal, held, digest.hexdigest()[:16], order
+    return records, cal, held, digest.hexdigest()[:16], order, aside
 
 
 def _fit_and_store(job) -> Fit:
@@ -237,7 +248,11 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     still above the absolute criterion is then refitted on from its own values. A path whose start is a member
     of an earlier path's end that explains the data (and is no possible stand-in) is not tried. Of the ends of
     these paths, a larger model is selected only by the same rule, and of two as large whose misfits are both
-    within the noise, the one with fewer parameters (selection.simpler_or_better). Adds the fits and held-out
+    within the noise, the one with fewer parameters (selection.simpler_or_better). When then no single effect
+    and not the model selected meets the absolute criterion, the `cfg.grid_models` models with the lowest
+    held-out misfit are each refitted from the best point of a grid over their members' strengths
+    (systems.strength_grid; a pair's valley where a descent from its members' refits stops short), and the
+    selection is made again with them. Adds the fits and held-out
     simulations to `fits` and `sims`; returns the system with the combined effects among its effects and the
     model selected (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
@@ -376,13 +391,14 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             current = best
         return pruned(current)
 
-    def onward(name, values, budget, stored_as):
-        # the model `name` refitted from `values` only, with `budget` evaluations on every core, stored as
-        # fits/<stored_as>.json; it replaces the model's fit when its calibration misfit is lower
+    def onward(name, values, budget, stored_as, grid=()):
+        # the model `name` refitted from `values` (or the best of `grid`, points overriding them), with `budget`
+        # evaluations on every core, stored as fits/<stored_as>.json; it replaces the model's fit when its
+        # calibration misfit is lower
         path = out / "fits" / f"{stored_as}.json"
         task = effect_task(system, effects[name], fmu, cal, nominal, scale, budget, cfg.upsample, seeds=(values,))
         fit = _stored(path, key) or _fit_and_store((dataclasses.replace(
-            task, start=task.alternatives[-1], alternatives=(), basin=None, threads=alone), str(path), key))
+            task, start=task.alternatives[-1], alternatives=grid, basin=None, threads=alone), str(path), key))
         if fit.calibration_nrmse < fits[name].calibration_nrmse:  # its cost includes the fit it goes on from
             fits[name] = dataclasses.replace(fit, evaluations=fit.evaluations + fits[name].evaluations,
                                              wall_s=fit.wall_s + fits[name].wall_s)
@@ -431,6 +447,16 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         # (not so a free-shape loop still above the noise: it can take up a strong spring's part beyond the reach
         # of its sensitivity to the spring, where the path from the spring finds the weak loop beside it)
     selected = functools.reduce(kept, ends)
+    singles = [n for n in fits if not effects[n].members]
+    if all(after[n] > explained_below for n in singles + [selected]):
+        # nothing explains the data: the best models, each refitted from the best point of a grid over its
+        # members' strengths (its other parameters at its refit); then selected again among the paths' ends
+        gridded = sorted(after, key=after.get)[:cfg.grid_models]
+        for name in gridded:
+            members = [system.effects[m] for m in effects[name].members or (name,)]
+            onward(name, fits[name].params, cfg.refit_budget, f"{_stem(name)}.gridded",
+                   strength_grid(members, scale, fits[name].params))
+        selected = functools.reduce(kept, ends + [n for n in gridded if n not in ends])
     return dataclasses.replace(system, effects=effects), selected
 
 
@@ -480,7 +506,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     system = make_system(model, fmu_defaults(runner), described)
     if users:
         system = _with_user_candidates(system, users, set(runner.parameter_names()))
-    records, cal, held, data_key, level_order = _load(data_dir, system, cfg, runner)
+    records, cal, held, data_key, level_order, aside = _load(data_dir, system, cfg, runner)
     lo, hi = localise.excited_range(records)
     modes = linear_modes(fmu, {**system.nominal_fixed, **system.start(cal)})
 
@@ -498,7 +524,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     (out / "fits").mkdir(parents=True, exist_ok=True)
     judging = ("min_gap", "noise_factor", "close_points", "min_shrink_pct", "explain_factor", "explain_margin",
                "nominal_max_nrmse", "max_effects", "partners", "min_excess_cut", "beam", "combination_min_gap",
-               "min_partner_explained")
+               "min_partner_explained", "grid_models")
     # (how results are judged and which combinations are tried, not how a fit is made: stored fits stay valid)
     settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in judging}, sort_keys=True)
     description = json.dumps({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}
@@ -565,6 +591,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
                              selected)
     result["level_order"] = level_order
+    result["set_aside"] = {name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in aside.items()}
     top = result["ranking"][0]["shrink_pct"] if result["ranking"] else None
     result["confidence"] = (confidence.stated(result["verdict"], result["chosen_effect"], top, confidence.load())
                             if model == confidence.FAMILY else None)

@@ -139,6 +139,28 @@ def noise_estimates(records: list[Record], level_scaled: bool = False,
     return out
 
 
+UNSETTLED_NRMSE = 0.05  # a response that differs between periods by this share of its RMS ...
+UNSETTLED_FACTOR = 3.0  # ... and by this many times the noise floor of a lower level is no steady state
+
+
+def unsettled(records: list[Record]) -> dict[str, tuple[float, float]]:
+    """Periodic records whose response does not repeat from one period to the next: their period scatter (an
+    NRMSE) exceeds UNSETTLED_NRMSE and UNSETTLED_FACTOR x the noise floor of a record at a lower level. Sensor
+    noise relative to the response does not grow with the level (a fixed noise falls relative to it, a range
+    set per level keeps it), so such scatter is the response itself: chaotic, subharmonic or still settling,
+    which no simulation follows sample by sample. Name -> (its scatter, the lowest floor of a lower level)."""
+    per = channel_noise(records)
+    floors = noise_estimates(records, per=per)
+    out = {}
+    for r in records:
+        lower = [floors[q.name][0] for q in records if q.level_value < r.level_value]
+        scatter = floors[r.name][0]
+        if all(m == "period scatter" for _, m in per[r.name].values()) and lower and \
+                scatter > max(UNSETTLED_NRMSE, UNSETTLED_FACTOR * min(lower)):
+            out[r.name] = (scatter, min(lower))
+    return out
+
+
 def by_band(sim: dict, rec: Record, bands: list[tuple[float, float]]) -> list[float]:
     """Contribution of each band [Hz] to the NRMSE: sqrt(residual power in band / total output power)."""
     res = []

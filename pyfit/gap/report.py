@@ -347,6 +347,14 @@ def starts_text(starts: list[dict]) -> str:
     return "; ".join(parts) + " (each start in report.json, `listed_starts`)"
 
 
+def _set_aside_lines(aside: dict) -> list[str]:
+    """The files the default split left out (localise.unsettled), with why, as markdown lines."""
+    return [f"Set aside: {name} (its response differs from one period to the next by {100 * d['period_scatter']:.1f} "
+            f"% of its RMS, {d['period_scatter'] / d['lower_floor']:.0f} x the noise floor of a lower level: no "
+            "steady state, chaotic or still settling, which no simulation follows sample by sample; calibrating on "
+            "it would pull every parameter off).\n" for name, d in aside.items()]
+
+
 def markdown(result: dict) -> str:
     """The report as markdown (tables, evidence, figures)."""
     g = result["gap"]
@@ -357,7 +365,7 @@ def markdown(result: dict) -> str:
     lines += [
         f"Calibrated on {', '.join(result['calibration_files'])}; held out: "
         f"{', '.join(result['held_out_files'])}. Levels ordered by {result['level_order']}.",
-        "",
+        ""] + _set_aside_lines(result.get("set_aside", {})) + [
         f"Held-out gap (NRMSE) of the nominal model: **{g['overall']:.4f}**; noise floor from the data: "
         f"{g['noise_floor']:.4f} ({', '.join(g.get('noise_floor_method', []))}){_scaled_floor(g)}; nominal "
         f"calibration NRMSE {result['nominal']['calibration_nrmse']:.4f}. An effect explains the gap when the held-out NRMSE with "

@@ -10,6 +10,7 @@ that element (SI units throughout).
 """
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -131,6 +132,31 @@ def combine(effects: list[Effect]) -> Effect:
                   starts=lambda s: [st for e in effects for st in e.starts(s)], members=tuple(names),
                   derived=lambda s: tuple(r for e in effects for r in e.derived(s)),
                   basin=next((e.basin for e in effects if e.basin), None))
+
+
+GRID_NEAR = np.geomspace(0.8, 1.25, 9)  # a member's strengths at its refit times these ...
+GRID_ACROSS = np.geomspace(1e-4, 1.0, 9)  # ... at each end of their range (one that holds zero) times these
+
+
+def strength_grid(members: list[Effect], scale: Scale, values: dict) -> tuple[dict, ...]:
+    """Points spanning the strengths of a model's `members` (each member's strength parameters moved together:
+    at `values` x GRID_NEAR, at each nonzero end of their ranges x GRID_ACROSS when the range holds zero, and
+    at zero), every other parameter where `values` has it: the product over the members (a grid of a pair's two
+    strengths, where two effects trading off, a hardening spring and a damper that both set where a sweep jumps,
+    leave a narrow valley a descent from either member's refit does not find)."""
+    axes = []
+    for e in members:
+        ranges = {p.name: p.range(scale) for p in e.params if not p.shape}
+        if not ranges:
+            continue
+        axis = [{n: values[n] * f for n in ranges} for f in GRID_NEAR] if any(values[n] for n in ranges) else []
+        if all(lo <= 0.0 <= hi for lo, _, hi in ranges.values()):
+            for end in (0, 2):
+                if any(r[end] for r in ranges.values()):
+                    axis += [{n: r[end] * f for n, r in ranges.items()} for f in GRID_ACROSS]
+            axis.append(dict.fromkeys(ranges, 0.0))
+        axes.append(axis)
+    return tuple({n: v for point in combo for n, v in point.items()} for combo in itertools.product(*axes))
 
 
 def _sym(scale_fn):
