@@ -34,6 +34,17 @@ def fmu_dir(tmp_path_factory, worker_id):
     return out
 
 
+@pytest.fixture(scope="module")
+def sdof_system(fmu_dir):
+    """The SDOF FMU's runner and the diagnosis's system built on its defaults (pyfit.gap.systems)."""
+    from pyfit.gap.diagnose import fmu_defaults
+    from pyfit.gap.systems import family_fmu, make_system
+
+    runner = FmuRunner(str(fmu_dir / f"{family_fmu('sdof')}.fmu"))
+    yield runner, make_system("sdof", fmu_defaults(runner), None)
+    runner.close()
+
+
 @pytest.fixture(scope="session")
 def benchmark_dir():
     """The official Bouc-Wen benchmark validation signals (third-party data, not in the repository): the folder

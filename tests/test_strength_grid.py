@@ -12,19 +12,11 @@ from pyfit.gap import campaign, datasets, localise, selection
 from pyfit.gap import diagnose as dg
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import effect_task, nominal_task, run_fit
-from pyfit.gap.systems import combine, family_fmu, make_system, strength_grid
-from pyfit.runtime.fmu import FmuRunner
+from pyfit.gap.systems import combine, strength_grid
 
 
-@pytest.fixture(scope="module")
-def sdof(fmu_dir):
-    runner = FmuRunner(str(fmu_dir / f"{family_fmu('sdof')}.fmu"))
-    yield runner, make_system("sdof", dg.fmu_defaults(runner), None)
-    runner.close()
-
-
-def test_the_grid_spans_each_members_strengths_and_holds_the_refit(sdof):
-    _, system = sdof
+def test_the_grid_spans_each_members_strengths_and_holds_the_refit(sdof_system):
+    _, system = sdof_system
     scale = system.scale([np.sin(np.linspace(0, 60, 3000)) * 1e-3], 500.0, {})
     members = [system.effects["cubic_stiffness"], system.effects["quadratic_damping"]]
     grid = strength_grid(members, scale, {"k3": 2.5e8, "c2": 0.0, "k": 1e5})
@@ -39,8 +31,9 @@ def test_the_grid_spans_each_members_strengths_and_holds_the_refit(sdof):
     assert min(c for c in c2s if c > 0) == pytest.approx(1e-4 * c2_hi)
 
 
-def test_a_spring_and_damper_setting_a_sweeps_jump_are_found_from_the_grid(tmp_path, sdof, measured):
-    runner, system = sdof
+def test_a_spring_and_damper_setting_a_sweeps_jump_are_found_from_the_grid(tmp_path, sdof_system,
+                                                                          measured):
+    runner, system = sdof_system
     fmu = runner.path
     case = campaign.draw(200, 18)[121]
     assert case.withheld == "cubic_stiffness+quadratic_damping" and case.excitation == "sweep"

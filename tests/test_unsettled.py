@@ -13,8 +13,6 @@ from gap_cases import CI
 from pyfit.gap import datasets, localise
 from pyfit.gap import diagnose as dg
 from pyfit.gap.simulate import Record
-from pyfit.gap.systems import family_fmu, make_system
-from pyfit.runtime.fmu import FmuRunner
 
 SPP, PERIODS, SETTLE = 64, 6, 150  # samples per forcing period, periods recorded, periods left to settle
 NOISE = 0.01  # sensor noise, relative to each record's RMS
@@ -66,15 +64,8 @@ def not_repeating(path, share: float, rng):
     np.savetxt(path, rows, delimiter=",", header=header, comments="", fmt="%.10g")
 
 
-@pytest.fixture(scope="module")
-def system(fmu_dir):
-    runner = FmuRunner(str(fmu_dir / f"{family_fmu('sdof')}.fmu"))
-    yield runner, make_system("sdof", dg.fmu_defaults(runner), None)
-    runner.close()
-
-
-def test_the_diagnosis_splits_the_other_files_and_says_why(tmp_path, system):
-    runner, sdof = system
+def test_the_diagnosis_splits_the_other_files_and_says_why(tmp_path, sdof_system):
+    runner, sdof = sdof_system
     rng = np.random.default_rng()
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "none", seed=int(rng.integers(1 << 31)),
                                   periods=2)
