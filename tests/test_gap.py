@@ -40,23 +40,19 @@ def test_interrupted_diagnosis_resumes_from_finished_refits(data_root, fmu_dir, 
             assert after[r["effect"]] == pytest.approx(r["shrink_pct"], abs=1e-9)
 
 
-def test_a_refit_is_the_same_on_one_thread_as_on_two(data_root, fmu_dir, monkeypatch):
+def test_a_refit_is_the_same_on_one_thread_as_on_two(data_root, sdof_system, monkeypatch):
     """A fit simulating its calibration records on two threads (one FMU instance each; every fit of a
     diagnosis on several cores may) ends at exactly the parameters and misfit it reaches on one (every run
     made afresh: the process's memory of runs keeps nothing here)."""
     from pyfit.gap.attribute import nominal_task
-    from pyfit.gap.systems import family_fmu, make_system
     from pyfit.runtime import drive
-    from pyfit.runtime.fmu import FmuRunner
     from pyfit.runtime.memo import BoundedMemo
 
     monkeypatch.setattr(drive, "RESPONSE_MEMO", BoundedMemo(max_bytes=0))
 
-    fmu = str(fmu_dir / f"{family_fmu('sdof')}.fmu")
-    runner = FmuRunner(fmu)
-    system = make_system("sdof", dg.fmu_defaults(runner), None)
+    runner, system = sdof_system
+    fmu = runner.path
     _, cal, _, _, _, _ = dg._load(case(data_root, "cubic_stiffness"), system, CI, runner)
-    runner.close()
     assert len(cal) >= 2  # two records to simulate at once
     one, two = (dg.run_fit(nominal_task(system, fmu, cal, 12, CI.upsample, threads=n)) for n in (1, 2))
     assert one.params == two.params and one.calibration_nrmse == two.calibration_nrmse

@@ -155,7 +155,8 @@ def strength_grid(members: list[Effect], scale: Scale, values: dict) -> tuple[di
                 if any(r[end] for r in ranges.values()):
                     axis += [{n: r[end] * f for n, r in ranges.items()} for f in GRID_ACROSS]
             axis.append(dict.fromkeys(ranges, 0.0))
-        axes.append(axis)
+        if axis:  # (a member at zero whose range does not hold zero has no points: it stays where it is)
+            axes.append(axis)
     return tuple({n: v for point in combo for n, v in point.items()} for combo in itertools.product(*axes))
 
 
