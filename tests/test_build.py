@@ -113,3 +113,35 @@ def test_the_build_is_the_same_in_every_process(fmu_dir):
     other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT,
                            env={**os.environ, "PYTHONHASHSEED": seed}).stdout.strip()
     assert other == read_model_description(str(fmu_dir / "DamperElement.fmu")).guid
+
+
+def test_an_fmu_older_than_the_c_wrapper_is_rebuilt_and_a_current_one_kept(fmu_dir, tmp_path):
+    """ensure_fmu rebuilds an FMU older than any of its sources: the .mo files and the build's C (the FMI wrapper
+    with its solver), so a clone that pulls a faster or mended wrapper does not keep running the old one."""
+    from pyfit.build import C_SOURCES
+    from pyfit.runtime.examples import ensure_fmu
+
+    path = tmp_path / "MassSpringDamper.fmu"
+    shutil.copy(fmu_dir / "MassSpringDamper.fmu", path)
+    newest = max(p.stat().st_mtime for p in [*LIBRARY.rglob("*.mo"), *C_SOURCES])
+    os.utime(path, (newest + 10, newest + 10))
+    ensure_fmu("MassSpringDamper", tmp_path)
+    assert path.stat().st_mtime == newest + 10  # newer than every source: kept
+    wrapper = max(C_SOURCES, key=lambda p: p.stat().st_mtime)
+    os.utime(path, (wrapper.stat().st_mtime - 10, wrapper.stat().st_mtime - 10))
+    ensure_fmu("MassSpringDamper", tmp_path)
+    assert path.stat().st_mtime >= wrapper.stat().st_mtime  # older than the C wrapper: rebuilt
+    assert read_model_description(str(path)).modelName.endswith(".MassSpringDamper")
+
+
+def test_processes_building_the_same_fmu_at_once_all_succeed(tmp_path):
+    """Workers that each find an FMU out of date rebuild it at the same moment: each writes its own partial file
+    and renames it into place, so every build succeeds, the FMU left is whole, and no partial file stays."""
+    code = ("import pathlib, sys; from pyfit.build import EXAMPLES, build_fmu; "
+            "build_fmu(EXAMPLES['MassSpringDamper'], pathlib.Path(sys.argv[1]), 'MassSpringDamper')")
+    procs = [subprocess.Popen([sys.executable, "-c", code, str(tmp_path)], stderr=subprocess.PIPE, text=True)
+             for _ in range(6)]
+    errors = [p.communicate()[1] for p in procs]
+    assert [p.returncode for p in procs] == [0] * len(procs), errors
+    assert not list(tmp_path.rglob("*.partial"))
+    assert validate_fmu(str(tmp_path / "MassSpringDamper.fmu")) == []

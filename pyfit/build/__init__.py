@@ -11,7 +11,10 @@ from dataclasses import dataclass
 
 from pyfit.catalog import EXAMPLES, LIBRARY, ModelicaError
 
-__all__ = ["ModelicaError", "EXAMPLES", "build_fmu", "build_all", "fmi3_path", "LIBRARY"]
+__all__ = ["ModelicaError", "EXAMPLES", "build_fmu", "build_all", "fmi3_path", "LIBRARY", "C_SOURCES"]
+
+# the hand-written C every FMU is compiled with (the FMI 2.0 wrapper with its solvers, the FMI 3.0 adapter)
+C_SOURCES = tuple(sorted(pathlib.Path(__file__).parent.glob("*.c")))
 
 
 @dataclass

@@ -121,6 +121,15 @@ def casadi_functions(model: ExplicitModel, ident: str) -> list[ca.Function]:
     return functions
 
 
+def state_aliases(model: ExplicitModel) -> list[int]:
+    """For each variable (in the order of the vars function's output): the index over (inputs, states) of the input
+    or state it equals, or -1 when it is computed. Such a variable is read from that input or state: an output that
+    is a state (a displacement sensor on a mass) costs no evaluation of every variable at each communication point."""
+    known = [model.u[i] for i in range(model.u.numel())] + [model.x[i] for i in range(model.x.numel())]
+    return [next((k for k, s in enumerate(known) if ca.is_equal(e, s)), -1) if e.is_symbolic() else -1
+            for e in model.variable_expr]
+
+
 def write_sources(model: ExplicitModel, ident: str, guid: str, variables: list[FmuVariable],
                   folder: pathlib.Path) -> list[str]:
     """Write model_functions.c/.h and model_data.h into `folder`; return the C file names."""
@@ -160,6 +169,7 @@ def write_sources(model: ExplicitModel, ident: str, guid: str, variables: list[F
     lines.append("static const double START_VALUES[] = {" + ", ".join(repr(float(s)) for s in starts) + "};")
     lines.append("static const int VAR_TYPE[] = {" + ", ".join(str(types[v.type]) for v in variables) + "};")
     lines.append("static const int VAR_SETTABLE[] = {" + ", ".join(str(v.settable) for v in variables) + "};")
+    lines.append("static const int VAR_ALIAS[] = {" + ", ".join(str(k) for k in state_aliases(model) or [-1]) + "};")
     lines.append("#endif")
     (folder / "model_data.h").write_text("\n".join(lines) + "\n")
     return ["model_functions.c", "fmi2_wrapper.c"]

@@ -81,6 +81,9 @@ typedef struct {
   double xscale[ARRSZ(N_STATES)];
   double utmp[ARRSZ(N_INPUTS)];
   double h_last;
+  /* the last step's final stage, kept for the next step's first (first same as last): its arguments and result */
+  int last_valid;
+  double last_t, last_x[ARRSZ(N_STATES)], last_u[ARRSZ(N_INPUTS)], last_xdot[ARRSZ(N_STATES)];
   double seed[ARRSZ(N_XU)];       /* directional derivative: the seed over (states, inputs) ... */
   double jacobian[ARRSZ(N_OUT)];  /* ... and J · seed over (state derivatives, variables) */
 } Instance;
@@ -138,6 +141,7 @@ static int call_ode(Instance *c, const double *x, const double *u, double t, dou
 static int update_calculated(Instance *c) {
   ModelFunction hoist = FUN_HOIST;
   if (!c->params_dirty) return 0;
+  c->last_valid = 0; /* the derivative kept for the next step was computed with the parameters before */
 #if N_CALC > 0
   c->arg[0] = c->v;
   c->res[0] = c->v + OFS_CALC;
@@ -207,6 +211,7 @@ static void reset_values(Instance *c) {
   c->dirty = DIRTY_ALL;
   c->params_dirty = 1;
   c->h_last = 0.0;
+  c->last_valid = 0;
   c->state = ST_INSTANTIATED;
 }
 
@@ -330,18 +335,26 @@ static fmi2Status check_vr(Instance *c, fmi2ValueReference vr, int type) {
   return fmi2OK;
 }
 
+/* where the value of `vr` is kept: a variable that equals an input or a state (VAR_ALIAS) is read from it */
+static fmi2ValueReference source_of(fmi2ValueReference vr) {
+  return vr >= OFS_VAR && vr < N_TOTAL && VAR_ALIAS[vr - OFS_VAR] >= 0 ? OFS_INPUT + VAR_ALIAS[vr - OFS_VAR] : vr;
+}
+
 static fmi2Status get_values(Instance *c, const fmi2ValueReference vr[], size_t n, double *out, int type) {
   size_t i;
-  int need = DIRTY_VAR;
+  int need = 0; /* the variables are computed only when one that is not an input or state is read */
   GUARD(ANY_BUT_ERROR, 0, "fmi2Get<Type>");
-  for (i = 0; i < n; i++) if (vr[i] >= OFS_DER && vr[i] < OFS_VAR) need = DIRTY_ALL;
+  for (i = 0; i < n; i++) {
+    if (vr[i] >= OFS_DER && vr[i] < OFS_VAR) need = DIRTY_ALL;
+    else if (source_of(vr[i]) >= OFS_VAR) need |= DIRTY_VAR;
+  }
   if (c->state != ST_INSTANTIATED && update(c, need) != fmi2OK) {
-    for (i = 0; i < n; i++) if (vr[i] < N_TOTAL) out[i] = c->v[vr[i]];
+    for (i = 0; i < n; i++) if (vr[i] < N_TOTAL) out[i] = c->v[source_of(vr[i])];
     return fmi2Error;
   }
   for (i = 0; i < n; i++) {
     if (check_vr(c, vr[i], type) != fmi2OK) return fmi2Error;
-    out[i] = c->v[vr[i]];
+    out[i] = c->v[source_of(vr[i])];
   }
   return fmi2OK;
 }
@@ -678,6 +691,28 @@ static const double DP_A[7][6] = {
     {35.0 / 384, 0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}};
 static const double DP_E[7] = {71.0 / 57600, 0, -71.0 / 16695, 71.0 / 1920, -17253.0 / 339200, 22.0 / 525, -1.0 / 40};
 
+/* the state derivative at (x, u, t) into xdot. The last step's final stage is kept with its arguments: a step
+   whose first stage has the same arguments to the bit (the next step of a Dormand-Prince integration starts where
+   the last stage of the one before was evaluated; across communication points too, when the input the importer
+   sets is the one the step ended with) takes it instead of calling the model: the same values, one call fewer */
+static int first_stage(Instance *c, const double *x, const double *u, double t, double *xdot) {
+  if (c->last_valid && memcmp(&t, &c->last_t, sizeof t) == 0 &&
+      memcmp(x, c->last_x, sizeof(double) * N_STATES) == 0 &&
+      memcmp(u, c->last_u, sizeof(double) * N_INPUTS) == 0) {
+    memcpy(xdot, c->last_xdot, sizeof(double) * N_STATES);
+    return 0;
+  }
+  return call_ode(c, x, u, t, xdot);
+}
+
+static void keep_last_stage(Instance *c, const double *x, const double *u, double t, const double *xdot) {
+  c->last_t = t;
+  memcpy(c->last_x, x, sizeof(double) * N_STATES);
+  memcpy(c->last_u, u, sizeof(double) * N_INPUTS);
+  memcpy(c->last_xdot, xdot, sizeof(double) * N_STATES);
+  c->last_valid = 1;
+}
+
 /* adaptive integration from t0 to t0 + H; returns 0 on success */
 static int dopri_integrate(Instance *c, const double *u0, double t0, double H, double *x) {
   double t = t0, tend = t0 + H, h = c->h_last > 0 ? c->h_last : H;
@@ -692,7 +727,9 @@ static int dopri_integrate(Instance *c, const double *u0, double t0, double H, d
         for (j = 0; j < s; j++) acc += DP_A[s][j] * c->k[j][i];
         c->xtmp[i] = x[i] + h * acc;
       }
-      if (call_ode(c, c->xtmp, inputs_at(c, u0, t + DP_C[s] * h - t0), t + DP_C[s] * h, c->k[s])) return 1;
+      const double *u = inputs_at(c, u0, t + DP_C[s] * h - t0);
+      if ((s ? call_ode : first_stage)(c, c->xtmp, u, t + DP_C[s] * h, c->k[s])) return 1;
+      if (s == 6) keep_last_stage(c, c->xtmp, u, t + DP_C[s] * h, c->k[s]);
     }
     for (i = 0; i < N_STATES; i++) {
       double e = 0.0, sc;

@@ -8,6 +8,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import zipfile
 
 import fmpy
@@ -39,7 +40,9 @@ def _run(cmd: list[str], ident: str) -> None:
 def _zip(fmu_path: pathlib.Path, documents: dict[str, bytes], lib: pathlib.Path, binaries: str,
          sources: list[pathlib.Path]) -> None:
     fmu_path.parent.mkdir(parents=True, exist_ok=True)
-    partial = fmu_path.with_suffix(".fmu.partial")
+    # a name of this process's own: two processes building the same FMU at once (two workers that both found it
+    # older than its sources) must not move each other's file away
+    partial = fmu_path.with_suffix(f".fmu.{os.getpid()}.{threading.get_ident()}.partial")
     with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as z:
         for name, data in documents.items():
             z.writestr(name, data)
@@ -60,7 +63,7 @@ def compile_and_zip(ident: str, src_dir: pathlib.Path, documents: dict[str, dict
     for h in HEADERS:
         shutil.copy(header_dir / h, src_dir / h)
     cc = cc or os.environ.get("CC", "gcc")
-    flags = ["-fPIC", "-O2", "-std=c99", "-I", str(src_dir)]
+    flags = ["-fPIC", "-O3", "-std=c99", "-I", str(src_dir)]
     units = {"model": "model_functions.c", "fmi2": FMI2_WRAPPER.name, "fmi3": FMI3_ADAPTER.name}
     sources = {"2.0": ["model", "fmi2"], "3.0": ["model", "fmi2", "fmi3"]}
     headers = sorted(p for p in src_dir.iterdir() if p.suffix == ".h")

@@ -6,15 +6,16 @@ import pathlib
 import numpy as np
 from fmpy import read_model_description
 
-from pyfit.build import EXAMPLES, LIBRARY, build_fmu
+from pyfit.build import C_SOURCES, EXAMPLES, LIBRARY, build_fmu
 from pyfit.runtime.fmu import FmuRunner
 
 
 def ensure_fmu(name: str, fmu_dir: pathlib.Path) -> pathlib.Path:
     """Path of the example's FMU, built from the .mo sources if it is missing or older than any of them (the
-    .mo files are the single source of truth)."""
+    .mo files are the single source of truth) or than the build's own C sources (the FMI wrapper and solver)."""
     path = pathlib.Path(fmu_dir) / f"{name}.fmu"
-    newest_source = max(p.stat().st_mtime for p in LIBRARY.rglob("*.mo"))
+    sources = [*LIBRARY.rglob("*.mo"), *C_SOURCES]
+    newest_source = max(p.stat().st_mtime for p in sources)
     if not path.exists() or path.stat().st_mtime < newest_source:
         build_fmu(EXAMPLES[name], pathlib.Path(fmu_dir), name)
     return path
