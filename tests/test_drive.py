@@ -77,3 +77,18 @@ def test_a_run_made_before_is_returned_not_made_again_and_a_failed_one_is_made_a
     bad = {**params, "k3": -1e14}
     assert not drive.drive(sdof, u, 500.0, ["y"], bad).ok and not drive.drive(sdof, u, 500.0, ["y"], bad).ok
     assert len(runs) == 4
+
+
+def test_a_runner_named_by_a_relative_path_runs_after_the_working_directory_changes(fmu_dir, tmp_path, monkeypatch):
+    """fmpy changes the working directory while it loads an FMU's library; a fit that simulates its records on
+    several threads loads one runner per thread, so another thread's relative path must not depend on the working
+    directory at that moment: a runner keeps the absolute path of the file it was given."""
+    from pyfit.runtime.fmu import FmuRunner
+
+    monkeypatch.chdir(fmu_dir.parent)
+    sdof = FmuRunner(f"{fmu_dir.name}/SDOFBoucWen.fmu")
+    monkeypatch.chdir(tmp_path)  # as fmpy's chdir in another thread does
+    u = {"u": 20.0 * np.sin(2 * np.pi * 30.0 * np.arange(500) / 500.0)}
+    res = drive.drive(sdof, u, 500.0, ["y"], {"exc_type": 0})
+    assert res.ok and np.max(np.abs(res["y"])) > 1e-5  # 20 N at 30 Hz on the benchmark's 2 kg, 5e4 N/m oscillator
+    sdof.close()

@@ -99,6 +99,11 @@ class FmuRunner:
     interface: str = "CoSimulation"  # or "ModelExchange"
     _state: dict = field(default_factory=dict, repr=False, compare=False)
 
+    def __post_init__(self):
+        # absolute from the start: fmpy changes the working directory while it loads an FMU's library, so a relative
+        # path read by another thread at that moment (a fit simulating its records on several threads) names nothing
+        self.path = str(pathlib.Path(self.path).absolute())
+
     def __getstate__(self):
         return {"path": self.path, "interface": self.interface, "_state": {}}
 
