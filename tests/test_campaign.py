@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from pyfit.gap import campaign, datasets
+from pyfit.gap import campaign, confidence, datasets
 from pyfit.gap.systems import DAMPER_LOOP_STARTS, SDOF_EFFECTS, SDOF_LOOP_STARTS, Scale
 
 
@@ -87,6 +87,24 @@ def test_the_summary_splits_singles_from_pairs_and_counts_a_pair_named_as_one_me
                             {"kind": "pairs", "cases": 3, "hits": 1, "one_member": 1}]
     assert "| pairs | 3 | 33 % | 1 |" in campaign.markdown({**s, "cases": 5, "seed": 0, "record_s": 6.0,
                                                                  "where": "here", "wall_s": 60.0, "command": "c"})
+
+
+def test_the_summary_bins_cases_by_their_weakest_withheld_effect():
+    drawn = [("cubic_stiffness+hysteresis", "hysteresis", {"cubic_stiffness": 1.5, "hysteresis": 40.0}),
+             ("cubic_stiffness+hysteresis", "cubic_stiffness+hysteresis", {"cubic_stiffness": 12.0, "hysteresis": 8.0}),
+             ("hysteresis", "hysteresis", {"hysteresis": 3.0}), ("hysteresis", "none", {"hysteresis": 1.2}),
+             ("none", "none", {})]
+    outcomes = [{"withheld": w, "named": n, "member_to_noise": m, "enr": 10.0, "top_shrink_pct": None,
+                 "stated": None, "data_s": 1.0, "diagnose_s": 1.0, "verdict": ""} for w, n, m in drawn]
+    s = campaign.summarise(outcomes)
+    rows = {confidence.range_label(*b["size"]): b for b in s["by_weakest"]}
+    assert rows["< 2"]["single"] == {"cases": 1, "hits": 0, "one_member": 0}
+    assert rows["< 2"]["pair"] == {"cases": 1, "hits": 0, "one_member": 1}  # its weaker member sets the bin
+    assert rows["2–5"]["single"]["hits"] == 1 and rows["5–10"]["pair"]["hits"] == 1
+    assert sum(b["single"]["cases"] + b["pair"]["cases"] for b in s["by_weakest"]) == 4  # nulls left out
+    text = campaign.markdown({**s, "cases": 5, "seed": 0, "record_s": 6.0, "where": "here", "wall_s": 60.0,
+                              "command": "c"})
+    assert "| < 2 | 1 | 0 % | 1 | 0 % | 1 |" in text and "| 5–10 | 0 | — | 1 | 100 % | 0 |" in text
 
 
 @pytest.mark.slow

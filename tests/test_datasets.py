@@ -1,5 +1,7 @@
 """Withheld-effect datasets (pyfit.gap.datasets) with a stepped sine and band-limited noise: what the files
 hold against the signal they were made from, and the excitations a family refuses."""
+import json
+
 import numpy as np
 import pytest
 
@@ -41,3 +43,23 @@ def test_a_noise_file_holds_band_limited_noise_at_its_level(written):
 def test_a_clamp_driven_damper_refuses_a_stepped_sine(tmp_path):
     with pytest.raises(ValueError, match="stepped_sine.*allowed: multisine, sweep, noise"):
         datasets.write_dataset(tmp_path, datasets.DAMPER, "none", style=datasets.LabStyle("stepped_sine"))
+
+
+def _size(tmp_path, effect: str, truth: dict) -> dict:
+    style = datasets.LabStyle("noise", record_s=2.0)
+    folder = tmp_path / effect / "_".join(f"{k}{v:g}" for k, v in truth.items())
+    path = datasets.write_dataset(folder, datasets.SDOF, effect, seed=5, style=style, truth=truth)
+    return json.loads((path / "truth.json").read_text())["member_to_noise"]
+
+
+def test_each_withheld_effect_is_sized_against_the_noise(tmp_path):
+    """A weak quadratic damper (c2 = 0.02 N·s²/m², a five-hundredth of the family's reference) changes the
+    response in proportion to c2 (first order), and beside a weak cubic spring by what it changes alone (their
+    cross term is second order); an effect at zero strength changes nothing."""
+    weak, twice = _size(tmp_path, "quadratic_damping", {"c2": 0.02}), _size(tmp_path, "quadratic_damping",
+                                                                             {"c2": 0.04})
+    assert twice["quadratic_damping"] / weak["quadratic_damping"] == pytest.approx(2.0, rel=0.03)
+    pair = _size(tmp_path, "cubic_stiffness+quadratic_damping", {"k3": 3e6, "c2": 0.02})
+    assert pair["quadratic_damping"] == pytest.approx(weak["quadratic_damping"], rel=0.05)
+    assert _size(tmp_path, "cubic_stiffness+quadratic_damping", {"k3": 3e6, "c2": 0.0})["quadratic_damping"] == 0.0
+    assert _size(tmp_path, "none", {}) == {}

@@ -10,9 +10,11 @@ cores); the output recorded (displacement or acceleration); the noise seed. The 
 case is measured, not set: the nominal model's held-out misfit over the noise floor, both from the report.
 
 The summary holds the confusion matrix (withheld × named), top-1 accuracy by effect-to-noise ratio (the
-detection limit), the false-alarm rate on the null cases, and the hit rate by the report's margin (the
-best candidate's held-out shrink): the calibration a single report's confidence is read from
-(pyfit.gap.confidence), and the check of the confidence the reports stated against what happened.
+detection limit) and by the weakest withheld effect's own size over the noise (from the truth: a pair's weaker
+member may hardly show where the pair stands far above the noise), the false-alarm rate on the null cases, and
+the hit rate by the report's margin (the best candidate's held-out shrink): the calibration a single report's
+confidence is read from (pyfit.gap.confidence), and the check of the confidence the reports stated against
+what happened.
 """
 from __future__ import annotations
 
@@ -175,6 +177,8 @@ def run_case(job: CaseJob) -> dict:
         outcome = {"named": "+".join(sorted((named or "").split(" + "))) or "none", "verdict": rep["verdict"],
                    "enr": gap["overall"] / gap["noise_floor"], "top_shrink_pct": top,
                    "stated": rep["confidence"]["rate"] if rep["confidence"] else None}
+        # each withheld effect's own size over the noise, from the truth (the diagnosis never reads it)
+        outcome["member_to_noise"] = json.loads((data / "truth.json").read_text())["member_to_noise"]
     except Exception as exc:  # a case that breaks the diagnosis is an outcome of the campaign, not its end
         outcome = {"named": "error", "verdict": f"{type(exc).__name__}: {exc}", "enr": None, "top_shrink_pct": None,
                    "stated": None}
@@ -241,6 +245,16 @@ def summarise(outcomes: list[dict]) -> dict:
         inside = [o for o in effects if confidence.bin_of(o["enr"], ENR_BINS) == k]
         by_enr.append({"enr": [ENR_BINS[k], ENR_BINS[k + 1]], "cases": len(inside),
                        "hits": sum(o["named"] == o["withheld"] for o in inside)})
+    by_weakest = []  # by the weakest withheld effect's own size over the noise (datasets.write_dataset)
+    sized = [o for o in effects if o.get("member_to_noise")]
+    for k in range(len(ENR_BINS) - 1):
+        inside = [o for o in sized if confidence.bin_of(min(o["member_to_noise"].values()), ENR_BINS) == k]
+        row = {"size": [ENR_BINS[k], ENR_BINS[k + 1]]}
+        for kind, size in (("single", 1), ("pair", 2)):
+            of = [o for o in inside if len(o["withheld"].split("+")) == size]
+            row[kind] = {"cases": len(of), "hits": sum(o["named"] == o["withheld"] for o in of),
+                         "one_member": sum(o["named"] in o["withheld"].split("+") for o in of)}
+        by_weakest.append(row)
     calibration = confidence.calibration_of(outcomes, "", 0)
     by_size = []
     for size, kind in ((1, "single effects"), (2, "pairs")):
@@ -250,7 +264,7 @@ def summarise(outcomes: list[dict]) -> dict:
     return {"labels": labels, "confusion": confusion, "by_size": by_size,
             "top1": sum(o["named"] == o["withheld"] for o in effects) / max(len(effects), 1),
             "effect_cases": len(effects), "null_cases": len(nulls),
-            "false_alarms": sum(o["named"] != "none" for o in nulls), "by_enr": by_enr,
+            "false_alarms": sum(o["named"] != "none" for o in nulls), "by_enr": by_enr, "by_weakest": by_weakest,
             "by_shrink": calibration["by_shrink"], "no_gap": calibration["no_gap"], "check": confidence.check(outcomes),
             "errors": sum(o["named"] == "error" for o in outcomes),
             "median_case_s": float(np.median([o["data_s"] + o["diagnose_s"] for o in outcomes]))}
@@ -284,6 +298,16 @@ def markdown(s: dict) -> str:
               "the noise floor)", "", "| effect-to-noise ratio | cases | named right |", "|---|---|---|"]
     lines += [f"| {confidence.range_label(*b['enr'])} | {b['cases']} | {_share(b['hits'], b['cases'])} |"
               for b in s["by_enr"]]
+    if any(b["single"]["cases"] + b["pair"]["cases"] for b in s.get("by_weakest", ())):
+        lines += ["", "**By the weakest withheld effect's own size**: the RMS of the truth less the truth with that "
+                  "effect off, over the RMS of the sensor noise (every level and output; before any model takes "
+                  "up part of it, so a pair's weaker member may be largely taken up by a refit of the other)", "",
+                  "| weakest effect's size over the noise | single effects | named right | pairs | named right | "
+                  "a pair named as one of its members |", "|---|---|---|---|---|---|"]
+        lines += [f"| {confidence.range_label(*b['size'])} | {b['single']['cases']} | "
+                  f"{_share(b['single']['hits'], b['single']['cases'])} | {b['pair']['cases']} | "
+                  f"{_share(b['pair']['hits'], b['pair']['cases'])} | {b['pair']['one_member']} |"
+                  for b in s["by_weakest"]]
     q = s["no_gap"]
     lines += ["", "**Calibration**: when a report names an effect, how often it is right, by the named model's "
               "held-out shrink (a single report states the rate of its row as its confidence)", "",

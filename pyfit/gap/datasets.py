@@ -121,7 +121,10 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     `style`, of the system `base` (FMU parameter overrides, e.g. a described damper; None: the defaults);
     truth.json beside it records the truth and what the effect changes at each level against the truth
     without it (Bouc-Wen as its tangent stiffness): the output RMS (RMS(y)/RMS(y_tangent) - 1) and the
-    output itself (RMS(y - y_tangent)/RMS(y_tangent)); the diagnosis never reads it."""
+    output itself (RMS(y - y_tangent)/RMS(y_tangent)); and each effect's size against the noise
+    (member_to_noise: the RMS of the truth less the truth with that effect off, over the RMS of the sensor
+    noise, the squares averaged over every level and output: how far the data show it beside the others, before
+    any model takes up part of it); the diagnosis never reads it."""
     if truth is None and any(e not in family.withheld for e in effect.split("+")):
         raise ValueError(f"effect '{effect}' unknown for {family.model}; allowed: {', '.join(family.withheld)} "
                          "(or several joined by '+', or the truth's parameters given)")
@@ -136,6 +139,9 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     spp, fs, lead = family.samples_per_period, family.fs, family.lead_periods
     rng = np.random.default_rng(seed)
     changes = {}
+    members = {e: {k: v for k, v in family.tangent.items() if k in family.withheld.get(e, {})}
+               for e in effect.split("+") if e != "none"}
+    member_sq, channels = {e: 0.0 for e, off in members.items() if off}, 0  # of the records' outputs
     kind, (f0, f1) = style.excitation, family.band_hz
     amplitude = kind in ("sweep", "stepped_sine")  # levels are amplitudes (else RMS values)
     levels, unit = SWEEP_LEVELS[family.model] if amplitude else (family.levels, family.level_unit)
@@ -158,6 +164,13 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
                                              {**physical, **family.tangent}, oversample=10, rtol=TRUTH_RTOL,
                                              atol=TRUTH_ATOL))[1]
         tk = t[keep] - t[keep][0]
+        sigma = {o: _noise_of(family, o, clean[o][keep]) for o in recorded}
+        channels += len(recorded)
+        for e in member_sq:  # the truth with this member off, the others on (one member: the tangent truth)
+            off = clean if len(members) == 1 else simulate_truth(SyntheticSpec(
+                family.model, signal, stop, fs, list(recorded), {**physical, **members[e]}, oversample=10,
+                rtol=TRUTH_RTOL, atol=TRUTH_ATOL))[1]
+            member_sq[e] += sum(np.mean((exact[o][keep] - off[o][keep]) ** 2) / sigma[o] ** 2 for o in recorded)
         num = sum(np.mean((exact[o][keep] - clean[o][keep]) ** 2) for o in recorded)
         den = sum(np.mean(clean[o][keep] ** 2) for o in recorded)
         rms = sum(np.mean(exact[o][keep] ** 2) for o in recorded)
@@ -172,7 +185,7 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
                       if kind == "multisine" else motion_with_derivatives(signal, t_in, ("x", "v", "a")))
             inputs = {f"{var}_meas": (motion[k], u, var) for k, u, var in
                       (("x", "m", "x_base"), ("v", "m/s", "v_base"), ("a", "m/s2", "a_base")) if k in style.motion}
-        outputs = {f"{o}_meas": (exact[o][keep] + rng.normal(0.0, _noise_of(family, o, clean[o][keep]), len(tk)),
+        outputs = {f"{o}_meas": (exact[o][keep] + rng.normal(0.0, sigma[o], len(tk)),
                                  UNITS.get(o, "m"), o) for o in recorded}
         shown = level * 1e3 if unit == "mm" else level
         name = f"level{i + 1}_{shown:g}{unit.replace('/', '')}.csv"
@@ -182,7 +195,9 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
                           notes=f"synthetic: CasADi reference (cvodes) at 10x the sensor rate, zero-phase FIR "
                                 f"anti-alias + decimation, noise {family.noise} m (or its equivalent), seed {seed}")
     (out / "truth.json").write_text(json.dumps({"effect": effect, "params": truth, "seed": seed,
-                                                "style": style.__dict__, "rms_change": changes}, indent=1))
+                                                "style": style.__dict__, "rms_change": changes,
+                                                "member_to_noise": {e: float(np.sqrt(v / channels))
+                                                                    for e, v in member_sq.items()}}, indent=1))
     return out
 
 
