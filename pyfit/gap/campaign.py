@@ -232,6 +232,13 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     return summary
 
 
+def _tally(outcomes: list[dict], size: int) -> dict:
+    """Of the outcomes withholding `size` effects: how many, how many named right, how many named as one member."""
+    inside = [o for o in outcomes if len(o["withheld"].split("+")) == size]
+    return {"cases": len(inside), "hits": sum(o["named"] == o["withheld"] for o in inside),
+            "one_member": sum(o["named"] in o["withheld"].split("+") for o in inside)}
+
+
 def summarise(outcomes: list[dict]) -> dict:
     """Confusion matrix, top-1 accuracy by effect-to-noise ratio, false alarms on nulls, hit rate by margin (the
     calibration), stated confidence against the hit rate."""
@@ -249,18 +256,10 @@ def summarise(outcomes: list[dict]) -> dict:
     sized = [o for o in effects if o.get("member_to_noise")]
     for k in range(len(ENR_BINS) - 1):
         inside = [o for o in sized if confidence.bin_of(min(o["member_to_noise"].values()), ENR_BINS) == k]
-        row = {"size": [ENR_BINS[k], ENR_BINS[k + 1]]}
-        for kind, size in (("single", 1), ("pair", 2)):
-            of = [o for o in inside if len(o["withheld"].split("+")) == size]
-            row[kind] = {"cases": len(of), "hits": sum(o["named"] == o["withheld"] for o in of),
-                         "one_member": sum(o["named"] in o["withheld"].split("+") for o in of)}
-        by_weakest.append(row)
+        by_weakest.append({"size": [ENR_BINS[k], ENR_BINS[k + 1]], "single": _tally(inside, 1),
+                           "pair": _tally(inside, 2)})
     calibration = confidence.calibration_of(outcomes, "", 0)
-    by_size = []
-    for size, kind in ((1, "single effects"), (2, "pairs")):
-        inside = [o for o in effects if len(o["withheld"].split("+")) == size]
-        by_size.append({"kind": kind, "cases": len(inside), "hits": sum(o["named"] == o["withheld"] for o in inside),
-                        "one_member": sum(o["named"] in o["withheld"].split("+") for o in inside)})
+    by_size = [{"kind": kind, **_tally(effects, size)} for size, kind in ((1, "single effects"), (2, "pairs"))]
     return {"labels": labels, "confusion": confusion, "by_size": by_size,
             "top1": sum(o["named"] == o["withheld"] for o in effects) / max(len(effects), 1),
             "effect_cases": len(effects), "null_cases": len(nulls),
