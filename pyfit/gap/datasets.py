@@ -124,7 +124,8 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     output itself (RMS(y - y_tangent)/RMS(y_tangent)); and each effect's size against the noise
     (member_to_noise: the RMS of the truth less the truth with that effect off, over the RMS of the sensor
     noise, the squares averaged over every level and output: how far the data show it beside the others, before
-    any model takes up part of it); the diagnosis never reads it."""
+    any model takes up part of it; only the effects `family.tangent` switches off, not a channel delay or a mass
+    offset); the diagnosis never reads it."""
     if truth is None and any(e not in family.withheld for e in effect.split("+")):
         raise ValueError(f"effect '{effect}' unknown for {family.model}; allowed: {', '.join(family.withheld)} "
                          "(or several joined by '+', or the truth's parameters given)")
