@@ -107,6 +107,24 @@ def test_the_summary_bins_cases_by_their_weakest_withheld_effect():
     assert "| < 2 | 1 | 0 % | 1 | 0 % | 1 |" in text and "| 5–10 | 0 | — | 1 | 100 % | 0 |" in text
 
 
+def test_the_summary_tells_misses_the_data_cannot_decide_from_misses_of_the_search():
+    # (withheld, named, named model's held-out NRMSE, the truth's held-out NRMSE, explanation threshold)
+    drawn = [("hysteresis", "hysteresis", 0.010, 0.010, 0.012),
+             ("cubic_stiffness+hysteresis", "hysteresis+quadratic_damping", 0.0058, 0.0060, 0.012),  # data: no
+             ("hysteresis", "none", 0.044, 0.011, 0.012),  # the search missed a truth within the threshold
+             ("cubic_stiffness+hysteresis", "hysteresis", 0.0105, 0.0078, 0.0050),  # the truth above it
+             ("none", "none", 0.005, 0.005, 0.012)]
+    outcomes = [{"withheld": w, "named": n, "named_held_out": a, "truth_held_out": t, "explained_below": e,
+                 "enr": 10.0, "top_shrink_pct": None, "stated": None, "data_s": 1.0, "diagnose_s": 1.0, "verdict": ""}
+                for w, n, a, t, e in drawn]
+    s = campaign.summarise(outcomes)
+    assert s["misses"] == {"judged": 3, "undecided": 1, "search": 2, "truth_unexplained": 1}
+    assert s["top1"] == pytest.approx(1 / 4) and s["top1_decided"] == pytest.approx(1 / 3)
+    text = campaign.markdown({**s, "cases": 5, "seed": 0, "record_s": 6.0, "where": "here", "wall_s": 60.0,
+                              "command": "c"})
+    assert "(the data cannot tell) | 1 |" in text and "Top-1 accuracy on the 3 cases the data decide: 33 %." in text
+
+
 @pytest.mark.slow
 def test_a_short_campaign_on_a_local_dask_cluster(tmp_path, fmu_dir, measured):
     summary = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)

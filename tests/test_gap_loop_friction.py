@@ -2,6 +2,7 @@
 budgets; the other two effects: test_gap.py, a file of their own so that the test workers share the four
 diagnoses): the withheld effect ranked first where it acts, the friction force recovered; the loop refit's starts
 ranked alike at the sensor rate and upsampled."""
+import json
 import shutil
 
 import numpy as np
@@ -25,6 +26,25 @@ def test_withheld_effect_is_found_where_it_acts_and_removes_the_gap(data_root, f
 
 def test_chosen_effect_recovers_the_withheld_friction_force(data_root, fmu_dir, measured):
     strength_recovered(data_root, fmu_dir, "coulomb_friction", "F_c", measured)
+
+
+def test_a_parameter_set_s_misfit_on_the_diagnosis_split(data_root, fmu_dir, measured):
+    """misfit_at on the withheld-friction dataset: at the calibrated nominal's values it gives the report's
+    held-out gap (the same split and simulation); at the truth (the CasADi reference's parameters, the nominal's
+    calibrated others kept) it stays within the noise floor's reach on both the held-out and the calibration
+    files (each against the floor of its own files: a lower level's is higher), far below the nominal's gap."""
+    out = diagnosed(data_root, fmu_dir, "coulomb_friction")
+    rep = json.loads((out / "report.json").read_text())
+    data = case(data_root, "coulomb_friction")
+    at_nominal = dg.misfit_at("sdof", data, rep["nominal"]["params"], CI, fmu_dir)
+    assert at_nominal.held_out == pytest.approx(rep["gap"]["overall"], rel=1e-9)
+    truth = json.loads((data / "truth.json").read_text())["params"]
+    at_truth = dg.misfit_at("sdof", data, {**rep["nominal"]["params"], **truth}, CI, fmu_dir)
+    floor = rep["gap"]["noise_floor"]
+    measured("truth's held-out NRMSE over the noise floor (withheld friction, FMU at the CasADi truth)",
+             at_truth.held_out / floor, 1.5)
+    cal_floor = np.sqrt(np.mean([d["noise_floor"] ** 2 for d in rep["gap"]["by_level"] if not d["held_out"]]))
+    assert at_truth.calibration < 1.5 * cal_floor and at_nominal.held_out > 5 * at_truth.held_out
 
 
 class _Captured(Exception):

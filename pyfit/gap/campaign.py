@@ -11,7 +11,9 @@ case is measured, not set: the nominal model's held-out misfit over the noise fl
 
 The summary holds the confusion matrix (withheld × named), top-1 accuracy by effect-to-noise ratio (the
 detection limit) and by the weakest withheld effect's own size over the noise (from the truth: a pair's weaker
-member may hardly show where the pair stands far above the noise), the false-alarm rate on the null cases, and
+member may hardly show where the pair stands far above the noise), the misses split into those the data cannot
+decide (the named model fits the held-out files at least as well as the truth) and those of the search, the
+false-alarm rate on the null cases, and
 the hit rate by the report's margin (the best candidate's held-out shrink): the calibration a single report's
 confidence is read from (pyfit.gap.confidence), and the check of the confidence the reports stated against
 what happened.
@@ -27,7 +29,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from pyfit.gap import confidence, datasets
-from pyfit.gap.diagnose import DiagnoseConfig, diagnose
+from pyfit.gap.diagnose import DiagnoseConfig, diagnose, misfit_at
 from pyfit.io.nominal import NominalModel
 from pyfit.runtime.batch import map_tasks
 
@@ -177,8 +179,17 @@ def run_case(job: CaseJob) -> dict:
         outcome = {"named": "+".join(sorted((named or "").split(" + "))) or "none", "verdict": rep["verdict"],
                    "enr": gap["overall"] / gap["noise_floor"], "top_shrink_pct": top,
                    "stated": rep["confidence"]["rate"] if rep["confidence"] else None}
-        # each withheld effect's own size over the noise, from the truth (the diagnosis never reads it)
-        outcome["member_to_noise"] = json.loads((data / "truth.json").read_text())["member_to_noise"]
+        # from the truth (the diagnosis never reads it): each withheld effect's own size over the noise, and the
+        # truth's own misfit on the diagnosis's split (the FMU at the true parameters over the calibrated
+        # nominal's others), against which a miss is one the data cannot decide or one of the search
+        truth = json.loads((data / "truth.json").read_text())
+        outcome["member_to_noise"] = truth["member_to_noise"]
+        at_truth = misfit_at(c.model, data, {**rep["nominal"]["params"], **truth["params"]}, fmu_dir=job.fmu_dir,
+                             nominal=described)
+        outcome.update(truth_held_out=at_truth.held_out, truth_calibration=at_truth.calibration,
+                       named_held_out=next((d["heldout_gap_after"] for d in rep["ranking"] if d["effect"] == named),
+                                           gap["overall"]),
+                       noise_floor=gap["noise_floor"], explained_below=rep["explained_below"])
     except Exception as exc:  # a case that breaks the diagnosis is an outcome of the campaign, not its end
         outcome = {"named": "error", "verdict": f"{type(exc).__name__}: {exc}", "enr": None, "top_shrink_pct": None,
                    "stated": None}
@@ -259,9 +270,17 @@ def summarise(outcomes: list[dict]) -> dict:
         by_weakest.append({"size": [ENR_BINS[k], ENR_BINS[k + 1]], "single": _tally(inside, 1),
                            "pair": _tally(inside, 2)})
     calibration = confidence.calibration_of(outcomes, "", 0)
+    # a miss the data cannot decide: the named model fits the held-out files at least as well as the truth does
+    judged = [o for o in effects if o["named"] != o["withheld"] and o.get("truth_held_out") is not None]
+    undecided = [o for o in judged if o["named_held_out"] <= o["truth_held_out"]]
+    searched = [o for o in judged if o not in undecided]
+    misses = {"judged": len(judged), "undecided": len(undecided), "search": len(searched),
+              "truth_unexplained": sum(o["truth_held_out"] > o["explained_below"] for o in searched)}
     by_size = [{"kind": kind, **_tally(effects, size)} for size, kind in ((1, "single effects"), (2, "pairs"))]
     return {"labels": labels, "confusion": confusion, "by_size": by_size,
             "top1": sum(o["named"] == o["withheld"] for o in effects) / max(len(effects), 1),
+            "misses": misses, "top1_decided": sum(o["named"] == o["withheld"] for o in effects)
+            / max(len(effects) - len(undecided), 1),
             "effect_cases": len(effects), "null_cases": len(nulls),
             "false_alarms": sum(o["named"] != "none" for o in nulls), "by_enr": by_enr, "by_weakest": by_weakest,
             "by_shrink": calibration["by_shrink"], "no_gap": calibration["no_gap"], "check": confidence.check(outcomes),
@@ -307,6 +326,17 @@ def markdown(s: dict) -> str:
                   f"{_share(b['single']['hits'], b['single']['cases'])} | {b['pair']['cases']} | "
                   f"{_share(b['pair']['hits'], b['pair']['cases'])} | {b['pair']['one_member']} |"
                   for b in s["by_weakest"]]
+    m = s.get("misses")
+    if m and m["judged"]:
+        lines += ["", "**Misses: the data or the search**: each miss's named model against the truth, both on the "
+                  "held-out files (the truth: the FMU at the true parameters over the calibrated nominal's others)",
+                  "", "| misses | cases |", "|---|---|",
+                  f"| the named model fits the held-out files at least as well as the truth (the data cannot tell) | "
+                  f"{m['undecided']} |",
+                  f"| the truth fits them better (a miss of the search or of the selection) | {m['search']} |",
+                  f"| of these, the truth itself above the explanation threshold | {m['truth_unexplained']} |", "",
+                  f"Top-1 accuracy on the {s['effect_cases'] - m['undecided']} cases the data decide: "
+                  f"{100 * s['top1_decided']:.0f} %."]
     q = s["no_gap"]
     lines += ["", "**Calibration**: when a report names an effect, how often it is right, by the named model's "
               "held-out shrink (a single report states the rate of its row as its confidence)", "",

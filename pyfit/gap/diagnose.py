@@ -601,3 +601,31 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     result["stage_s"] = clock.stages
     report.write(result, records, held, sims, bands, out)
     return result
+
+
+@dataclass(frozen=True)
+class SplitMisfit:
+    """One parameter set's NRMSE on a dataset as `diagnose` splits it: RMS over the held-out files and over the
+    calibration files (inf when a simulation fails)."""
+
+    held_out: float
+    calibration: float
+
+
+def misfit_at(model: str, data_dir, params: dict, cfg: DiagnoseConfig | None = None, fmu_dir="fmus",
+              nominal: NominalModel | str | None = None) -> SplitMisfit:
+    """The FMU of `model` at `params` (over the described nominal's fixed values and the FMU's defaults) on the
+    files of `data_dir`, split into calibration and held-out files as `diagnose` splits them with `cfg`: e.g. a
+    known truth's misfit, which tells a miss the data cannot decide from a miss of the search."""
+    cfg = cfg or DiagnoseConfig()
+    runner = FmuRunner(str(ensure_fmu(family_fmu(model), pathlib.Path(fmu_dir))))
+    try:
+        system = make_system(model, fmu_defaults(runner),
+                             load_nominal(nominal) if isinstance(nominal, (str, pathlib.Path)) else nominal)
+        _, cal, held, *_ = _load(data_dir, system, cfg, runner)
+        values = {**system.nominal_fixed, **params}
+        return SplitMisfit(*(selection.heldout_nrmse(
+            {r.name: sim.simulate(runner, r, values, cfg.upsample, system.lead_periods) for r in files}, files)
+            for files in (held, cal)))
+    finally:
+        runner.close()
