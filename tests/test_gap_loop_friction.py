@@ -1,7 +1,7 @@
 """Sim-to-real gap diagnosis on the withheld-hysteresis and withheld-Coulomb-friction SDOF datasets (CI
 budgets; the other two effects: test_gap.py, a file of their own so that the test workers share the four
 diagnoses): the withheld effect ranked first where it acts, the friction force recovered; the loop refit's starts
-ranked alike at the sensor rate and upsampled."""
+ranked alike at the sensor rate and upsampled; a parameter set's misfit on the diagnosis's split (misfit_at)."""
 import json
 import shutil
 
