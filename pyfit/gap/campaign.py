@@ -11,8 +11,8 @@ case is measured, not set: the nominal model's held-out misfit over the noise fl
 
 The summary holds the confusion matrix (withheld × named), top-1 accuracy by effect-to-noise ratio (the
 detection limit) and by the weakest withheld effect's own size over the noise (from the truth: a pair's weaker
-member may hardly show where the pair stands far above the noise), the misses split into those the data cannot
-decide (the named model fits the held-out files at least as well as the truth) and those of the search, the
+member may hardly show where the pair stands far above the noise), the misses split by cause (undetected; not
+favoured by the data: the named model fits the held-out files at least as well as the truth; of the search), the
 false-alarm rate on the null cases, and
 the hit rate by the report's margin (the best candidate's held-out shrink): the calibration a single report's
 confidence is read from (pyfit.gap.confidence), and the check of the confidence the reports stated against

@@ -203,12 +203,12 @@ def _campaign_headline(res: pathlib.Path) -> str | None:
     path = res / "campaign.md"
     if not path.is_file():
         return None
+    text = path.read_text(encoding="utf-8")
     m = re.search(r"Top-1 accuracy on the (\d+) cases with a withheld effect: (\d+) %; false alarms on the (\d+) "
-                  r"null cases: (\d+)", path.read_text(encoding="utf-8"))
+                  r"null cases: (\d+)", text)
     if not m:
         return None
-    decided = re.search(r"Top-1 accuracy on the (\d+) cases detected and decided by the data: (\d+) %",
-                        path.read_text(encoding="utf-8"))
+    decided = re.search(r"Top-1 accuracy on the (\d+) cases detected and decided by the data: (\d+) %", text)
     return (f"- **Validation campaign**: on {m[1]} random SDOF cases with one or two withheld effects (random "
             f"strengths, loop shapes, excitations, sensors) the diagnosis names exactly what was withheld in "
             f"{m[2]} %"
