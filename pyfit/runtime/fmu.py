@@ -113,7 +113,8 @@ class FmuRunner:
         if "md" not in self._state:
             if not pathlib.Path(self.path).is_file():
                 raise FileNotFoundError(f"{self.path}: FMU file not found")
-            self._state["md"] = read_model_description(self.path)
+            with _LOADING:  # libxml2 parses fmpy's XML schema: not while another thread parses it or loads an FMU
+                self._state["md"] = read_model_description(self.path)
         return self._state["md"]
 
     @property
