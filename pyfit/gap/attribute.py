@@ -290,21 +290,16 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
     `strength` (parameter -> value) scaled by STRENGTH_FACTORS (the step linearises an effect that is not
     linear in its strength: it can overshoot), each with the calibrated nominal's linear parameters and with
     each of `linear_starts` (e.g. the linear system estimated from the lowest level, where an
-    amplitude-dependent effect is weakest: the nominal's compromise over all levels can be far from it; the
-    effect's starts then scaled to that system's stiffness); and
+    amplitude-dependent effect is weakest: the nominal's compromise over all levels can be far from it); and
     `seeds` (parameter values of earlier fits, e.g. each member's own refit for a combination)."""
     start, bounds, fixed = effect_start(system, effect, scale, nominal.params)
     strengths = [{}] + [{n: v * f for n, v in strength.items()} for f in STRENGTH_FACTORS] if strength else [{}]
     shapes = list(effect.starts(scale))
     alternatives = [s for s in strengths if s] + shapes
     for linear in linear_starts:
-        # the effect's starts scaled to this linear system's stiffness: from the lowest level, a hysteretic
-        # element's small-amplitude stiffness k + alpha is that level's, not the nominal's compromise
-        at = dataclasses.replace(scale, k=scale.k * linear.get(system.stiffness, nominal.params[system.stiffness])
-                                 / nominal.params[system.stiffness])
-        lin_start, lin_bounds, _ = effect_start(system, effect, at, nominal.params, linear)
+        lin_start, lin_bounds, _ = effect_start(system, effect, scale, nominal.params, linear)
         bounds = {n: (min(bounds[n][0], lin_bounds[n][0]), max(bounds[n][1], lin_bounds[n][1])) for n in bounds}
-        alternatives += [{**lin_start, **s} for s in strengths + list(effect.starts(at))]
+        alternatives += [{**{n: lin_start[n] for n in system.linear}, **s} for s in strengths + shapes]
     for seed in seeds:  # clipped into the bounds by the unit scaling
         alternatives.append({n: seed[n] for n in start if n in seed})
     # the effect at zero is the calibrated nominal: the refit keeps it when it ends worse than that
