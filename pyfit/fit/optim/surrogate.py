@@ -20,6 +20,19 @@ class _deterministic:
         torch.use_deterministic_algorithms(self.was)
 
 
+class _one_thread:
+    """Context: torch on one thread, restored afterwards. The network is tiny: a second thread only adds
+    synchronisation to a population's forward pass, and the order of floating-point sums must not depend on
+    the core count."""
+
+    def __enter__(self):
+        self.was = torch.get_num_threads()
+        torch.set_num_threads(1)
+
+    def __exit__(self, *exc):
+        torch.set_num_threads(self.was)
+
+
 class Surrogate:
     """MLP residual model; `predict` evaluates a whole population in one batched forward pass."""
 
@@ -49,13 +62,8 @@ class Surrogate:
         Deterministic: seeded, one thread (the order of floating-point sums must not depend on the core
         count), deterministic kernels only; the same X, R and seed give the same network on any machine
         with the same torch build."""
-        threads = torch.get_num_threads()
-        torch.set_num_threads(1)
-        try:
-            with _deterministic():
-                return self._fit(X, R)
-        finally:
-            torch.set_num_threads(threads)
+        with _one_thread(), _deterministic():
+            return self._fit(X, R)
 
     def _fit(self, X: np.ndarray, R: np.ndarray) -> "Surrogate":
         torch.manual_seed(self.seed)
@@ -94,7 +102,7 @@ class Surrogate:
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         """Residual vectors (n, m) for parameters X (n, d)."""
-        with torch.no_grad():
+        with torch.no_grad(), _one_thread():
             y = self.net(torch.from_numpy(np.atleast_2d(np.asarray(X, float)))).numpy()
         return y * self.scale + self.mean
 
