@@ -62,15 +62,17 @@ def _oscillator(force_nl, seconds=12.0, fs=500.0, seed=0):
     f = np.arange(5.0, 80.0, 1.0)
     amp, phase = 20.0 * np.sqrt(2.0 / len(f)), rng.uniform(0, 2 * np.pi, len(f))
 
-    def u(t):
-        return amp * np.sum(np.cos(2 * np.pi * np.outer(np.atleast_1d(t), f) + phase), axis=1)
+    w = 2 * np.pi * f
 
-    def rhs(t, s):
-        return [s[1], float(u(t)[0]) - 2.0 * s[1] - 4e4 * s[0] - force_nl(s[0], s[1])]
+    def u(t):
+        return amp * np.sum(np.cos(np.outer(np.atleast_1d(t), w) + phase), axis=1)
+
+    def rhs(t, s):  # scalar: LSODA calls it hundreds of thousands of times
+        y, v = s
+        return [v, amp * float(np.cos(w * t + phase).sum()) - 2.0 * v - 4e4 * y - force_nl(y, v)]
 
     t = np.arange(0.0, seconds, 1.0 / fs)
-    sol = scipy.integrate.solve_ivp(rhs, (0.0, t[-1]), [0.0, 0.0], t_eval=t, rtol=1e-9, atol=1e-12, method="LSODA")
-    y, v = sol.y
+    y, v = scipy.integrate.odeint(rhs, [0.0, 0.0], t, rtol=1e-9, atol=1e-12, mxstep=100000, tfirst=True).T
     force = u(t)
     a = force - 2.0 * v - 4e4 * y - force_nl(y, v)
     return gap_peers.Motion(force + 1e-3 * np.std(force) * rng.standard_normal(len(t)), y, v, a, fs)

@@ -53,6 +53,8 @@ class NNOSettings:
     ga_generations: int = 60
     seed: int = 0
     trust_region: bool = False
+    max_epochs: int = 3000  # the surrogate's training: at most this many Adam epochs,
+    patience: int = 200  # stopping once the validation loss has not improved for this many
 
 
 @dataclass
@@ -196,7 +198,10 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None, nominal=None) -> Fit
         "init_sim": (int, False, 20), "hidden_sizes": (list, False, [15]), "p_size": (int, False, 20),
         "fun_tol": (float, False, 0.0), "x_tol": (float, False, 1e-3), "y_tol": (float, False, 1e-3),
         "ga_generations": (int, False, 50), "trust_region": (bool, False, False),
-        "log_ratio": (bool, False, False)})
+        "log_ratio": (bool, False, False), "max_epochs": (int, False, 3000), "patience": (int, False, 200)})
+    for key in ("max_epochs", "patience"):
+        if nn[key] < 1:
+            fail(path, f"nno.{key}", f"{nn[key]} training epochs", "a whole number ≥ 1")
     if nn["log_ratio"] and ob["kind"] != "psd_band":
         fail(path, "nno.log_ratio", "learns log(P/P_meas) of the relative PSD error", 'objective.kind = "psd_band"')
     raw_polish = dict(doc.get("polish", {}))
@@ -223,7 +228,7 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None, nominal=None) -> Fit
     settings = NNOSettings(init_sim=nn["init_sim"], hidden_sizes=[int(h) for h in nn["hidden_sizes"]],
                            p_size=nn["p_size"], fun_tol=nn["fun_tol"], max_sim=nno_budget, x_tol=nn["x_tol"],
                            y_tol=nn["y_tol"], ga_generations=nn["ga_generations"], seed=fit["seed"],
-                           trust_region=nn["trust_region"])
+                           trust_region=nn["trust_region"], max_epochs=nn["max_epochs"], patience=nn["patience"])
     return FitConfig(path=path, model=fit["model"], method=fit["method"], budget=fit["budget"], seed=fit["seed"],
                      target_file=target_file, synthetic=synthetic, fixed=fixed, objective_kind=ob["kind"],
                      channels=channels, segment_s=ob["segment_s"], warmup_s=ob["warmup_s"], penalty=ob["penalty"],

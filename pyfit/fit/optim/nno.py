@@ -92,7 +92,8 @@ def nno(residuals, n_var: int, settings: NNOSettings, x0: np.ndarray | None = No
             Xa, Ga = _local(Xa, Ga, X[best], radius, n_var)
         else:
             lower, upper = np.zeros(n_var), np.ones(n_var)
-        surrogate = Surrogate(settings.hidden_sizes, seed=settings.seed + it).fit(Xa, Ga)
+        surrogate = Surrogate(settings.hidden_sizes, seed=settings.seed + it, max_epochs=settings.max_epochs,
+                              patience=settings.patience).fit(Xa, Ga)
         problem = _SurrogateProblem(surrogate, lower, upper)
         if population is None:
             population = rng.random((settings.p_size, n_var))

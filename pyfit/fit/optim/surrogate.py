@@ -9,17 +9,6 @@ import numpy as np
 import torch
 
 
-class _deterministic:
-    """Context: torch's deterministic algorithms on, restored afterwards."""
-
-    def __enter__(self):
-        self.was = torch.are_deterministic_algorithms_enabled()
-        torch.use_deterministic_algorithms(True)
-
-    def __exit__(self, *exc):
-        torch.use_deterministic_algorithms(self.was)
-
-
 class _one_thread:
     """Context: torch on one thread, restored afterwards. The network is tiny: a second thread only adds
     synchronisation to a population's forward pass, and the order of floating-point sums must not depend on
@@ -59,10 +48,12 @@ class Surrogate:
     def fit(self, X: np.ndarray, R: np.ndarray) -> "Surrogate":
         """Train on parameters X (n, d) in [0, 1] and residual vectors R (n, m).
 
-        Deterministic: seeded, one thread (the order of floating-point sums must not depend on the core
-        count), deterministic kernels only; the same X, R and seed give the same network on any machine
-        with the same torch build."""
-        with _one_thread(), _deterministic():
+        Deterministic: seeded and on one thread, so the order of floating-point sums does not depend on the
+        core count; the CPU kernels it uses (linear layers, tanh, Adam) have no nondeterministic variant, so
+        the same X, R and seed give the same network on any machine with the same torch build. (torch's
+        use_deterministic_algorithms would add nothing on the CPU but the import of its compiler, seconds per
+        process.)"""
+        with _one_thread():
             return self._fit(X, R)
 
     def _fit(self, X: np.ndarray, R: np.ndarray) -> "Surrogate":
