@@ -3,6 +3,7 @@ a cubic spline otherwise), outputs on the file's time grid. A periodic record is
 periods are simulated in front of it and dropped. A failed or diverging run returns None."""
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -143,13 +144,21 @@ def residuals(sim: dict | None, rec: Record, penalty: float = 10.0, of=None) -> 
     return np.concatenate(parts)
 
 
+@functools.lru_cache(maxsize=16)
+def _low_pass(normalised_cutoff: float) -> tuple[np.ndarray, np.ndarray]:
+    """The envelope's 2nd-order Butterworth (b, a) at a cutoff over Nyquist: designed once, not per residual."""
+    import scipy.signal
+
+    return scipy.signal.butter(2, normalised_cutoff)
+
+
 def envelope(y: np.ndarray, fs: float, cutoff_hz: float = 2.0) -> np.ndarray:
     """Amplitude envelope of a record: |analytic signal| (Hilbert) of y minus its mean, low-passed at
     cutoff_hz (2nd-order Butterworth, zero phase)."""
     import scipy.signal
 
     e = np.abs(scipy.signal.hilbert(y - np.mean(y)))
-    b, a = scipy.signal.butter(2, min(cutoff_hz / (fs / 2), 0.5))
+    b, a = _low_pass(min(cutoff_hz / (fs / 2), 0.5))
     return scipy.signal.filtfilt(b, a, e)
 
 

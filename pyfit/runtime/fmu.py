@@ -160,11 +160,13 @@ class FmuRunner:
     # ---- parameters ------------------------------------------------------------------------------
     def check_parameters(self, params: dict) -> None:
         """Reject unknown names (listing the valid ones) and values outside declared min/max."""
-        valid = set(self.parameter_names())
-        settable = valid | {v.name for v in self.model_description.modelVariables
-                            if v.causality == "local" and v.initial == "exact"}
+        if "settable" not in self._state:  # every simulation checks its parameters: the names once per process
+            self._state["settable"] = set(self.parameter_names()) | {
+                v.name for v in self.model_description.modelVariables
+                if v.causality == "local" and v.initial == "exact"}
         for name, value in params.items():
-            if name not in settable:
+            if name not in self._state["settable"]:
+                valid = self.parameter_names()
                 raise ParameterError(f"{pathlib.Path(self.path).name}: unknown parameter '{name}'; "
                                      f"valid parameters: {', '.join(sorted(valid))}")
             v = self.variables[name]
