@@ -86,8 +86,24 @@ def test_the_summary_splits_singles_from_pairs_and_counts_a_pair_named_as_one_me
     s = campaign.summarise(outcomes)
     assert s["by_size"] == [{"kind": "single effects", "cases": 2, "hits": 1, "one_member": 1},
                             {"kind": "pairs", "cases": 3, "hits": 1, "one_member": 1}]
-    assert "| pairs | 3 | 33 % | 1 |" in campaign.markdown({**s, "cases": 5, "seed": 0, "record_s": 6.0,
-                                                                 "where": "here", "wall_s": 60.0, "command": "c"})
+    text = campaign.markdown({**s, "cases": 5, "seed": 0, "record_s": 6.0, "where": "here", "wall_s": 60.0,
+                              "command": "c"})
+    assert "| pairs | 3 | 33 % | 1 |" in text
+
+
+def test_the_summary_times_nulls_singles_and_pairs_apart():
+    spent = [("none", 10.0, 5.0), ("none", 20.0, 10.0), ("hysteresis", 40.0, 20.0),
+             ("cubic_stiffness+hysteresis", 100.0, 50.0), ("coulomb_friction+hysteresis", 300.0, 60.0),
+             ("cubic_stiffness+quadratic_damping", 200.0, 40.0)]
+    outcomes = [{"withheld": w, "named": "none", "enr": 10.0, "top_shrink_pct": None, "stated": None,
+                 "data_s": d, "diagnose_s": t, "verdict": ""} for w, t, d in spent]
+    s = campaign.summarise(outcomes)
+    assert s["times"] == [{"kind": "null cases", "cases": 2, "median_s": 22.5, "longest_s": 30.0},
+                          {"kind": "single effects", "cases": 1, "median_s": 60.0, "longest_s": 60.0},
+                          {"kind": "pairs", "cases": 3, "median_s": 240.0, "longest_s": 360.0}]
+    text = campaign.markdown({**s, "cases": 6, "seed": 0, "record_s": 6.0, "where": "here", "wall_s": 60.0,
+                              "command": "c"})
+    assert "| null cases | 2 | 22 | 30 |" in text and "| pairs | 3 | 240 | 360 |" in text
 
 
 def test_the_summary_bins_cases_by_their_weakest_withheld_effect():

@@ -254,6 +254,18 @@ def _tally(outcomes: list[dict], size: int) -> dict:
             "one_member": sum(o["named"] in o["withheld"].split("+") for o in inside)}
 
 
+def times_by_kind(outcomes: list[dict]) -> list[dict]:
+    """Per-case time (writing the files and diagnosing, one core) of the null cases, single effects and pairs:
+    how many, the median and the longest [s]."""
+    rows = []
+    for kind, size in (("null cases", 0), ("single effects", 1), ("pairs", 2)):
+        spent = [o["data_s"] + o["diagnose_s"] for o in outcomes
+                 if (0 if o["withheld"] == "none" else len(o["withheld"].split("+"))) == size]
+        rows.append({"kind": kind, "cases": len(spent), "median_s": float(np.median(spent)) if spent else None,
+                     "longest_s": max(spent) if spent else None})
+    return rows
+
+
 def split_misses(effects: list[dict], nulls: list[dict]) -> dict:
     """The misses among the effect cases whose outcome holds the truth's misfit, split by what kept the withheld
     effect(s) from being named: undetected (verdict 'no significant gap': the nominal's held-out misfit within the
@@ -304,7 +316,8 @@ def summarise(outcomes: list[dict]) -> dict:
             "false_alarms": sum(o["named"] != "none" for o in nulls), "by_enr": by_enr, "by_weakest": by_weakest,
             "by_shrink": calibration["by_shrink"], "no_gap": calibration["no_gap"], "check": confidence.check(outcomes),
             "errors": sum(o["named"] == "error" for o in outcomes),
-            "median_case_s": float(np.median([o["data_s"] + o["diagnose_s"] for o in outcomes]))}
+            "median_case_s": float(np.median([o["data_s"] + o["diagnose_s"] for o in outcomes])),
+            "times": times_by_kind(outcomes)}
 
 
 def _share(part: int, whole: int) -> str:
@@ -363,6 +376,12 @@ def markdown(s: dict) -> str:
                       f"decimation) and the other simulator, which a calibration takes up: on the null cases its "
                       f"held-out misfit is {m['handicap']:.2f} × the calibrated nominal's (median), so a model with "
                       "more freedom can fit the held-out files better than the truth; the middle row counts those."]
+    if s.get("times"):
+        lines += ["", "**Time per case** (writing the files and diagnosing them on one core, the other cores "
+                  "diagnosing other cases)", "", "| cases | number | median [s] | longest [s] |", "|---|---|---|---|"]
+        lines += [f"| {t['kind']} | {t['cases']} | "
+                  + (f"{t['median_s']:.0f} | {t['longest_s']:.0f} |" if t["cases"] else "— | — |")
+                  for t in s["times"]]
     q = s["no_gap"]
     lines += ["", "**Calibration**: when a report names an effect, how often it is right, by the named model's "
               "held-out shrink (a single report states the rate of its row as its confidence)", "",

@@ -80,7 +80,7 @@ RESULTS = {
                                        "stockbridge diagnose --campaign 100 --campaign-seed 19 --out "
                                        "results/campaign_check"),
     "docs/results/campaign_damper.md": ("results/campaign_damper/summary.md",
-                                        "stockbridge diagnose --campaign 6 --model damper --out "
+                                        "stockbridge diagnose --campaign 30 --model damper --out "
                                         "results/campaign_damper"),
     "docs/results/bench_peers_fit.md": ("results/bench/peers_fit.md", "python bench/peers_fit.py --seeds 3"),
     "docs/results/bench_peers_diagnosis.md": ("results/bench/peers_diagnosis_quick.md",
