@@ -198,7 +198,8 @@ def load_fit(path: str | pathlib.Path, fmu_parameters=None, nominal=None) -> Fit
         "init_sim": (int, False, 20), "hidden_sizes": (list, False, [15]), "p_size": (int, False, 20),
         "fun_tol": (float, False, 0.0), "x_tol": (float, False, 1e-3), "y_tol": (float, False, 1e-3),
         "ga_generations": (int, False, 50), "trust_region": (bool, False, False),
-        "log_ratio": (bool, False, False), "max_epochs": (int, False, 3000), "patience": (int, False, 200)})
+        "log_ratio": (bool, False, False), "max_epochs": (int, False, NNOSettings.max_epochs),
+        "patience": (int, False, NNOSettings.patience)})
     for key in ("max_epochs", "patience"):
         if nn[key] < 1:
             fail(path, f"nno.{key}", f"{nn[key]} training epochs", "a whole number ≥ 1")
