@@ -30,6 +30,7 @@ import numpy as np
 
 from pyfit.gap import confidence, datasets
 from pyfit.gap.diagnose import DiagnoseConfig, diagnose, misfit_at
+from pyfit.gap.systems import FAMILY
 from pyfit.io.nominal import NominalModel
 from pyfit.runtime.batch import map_tasks
 
@@ -103,8 +104,10 @@ def _damper_effect_truth(effect: str, rng) -> dict:
 def damper_geometry(rng) -> tuple[dict, tuple]:
     """A catalogue damper drawn at random: masses 0.5-4 kg, arms 0.1-0.3 m, mass offsets 0-50 mm, radii of
     gyration 30-60 mm, the messenger's EI 5-60 N·m² (log-uniform); drawn again until its two lowest resonances
-    (pyfit.reference.models.damper_modes_hz) lie within 4-60 Hz, as a catalogue damper's do. Returns the FMU
-    parameters and the test band [Hz] a lab would sweep: half the lowest resonance to 2.2 times the second."""
+    (pyfit.reference.models.damper_modes_hz) lie within 4-60 Hz, as a catalogue damper's do; then the
+    messenger's Rayleigh damping, alpha_pd 0.5-6 1/s and beta_pd 5e-5 to 8e-4 s (log-uniform: damping ratios of
+    about 0.5-7 % at 10 Hz; never the FMU's start values). Returns the FMU parameters and the test band [Hz] a
+    lab would sweep: half the lowest resonance to 2.2 times the second."""
     from pyfit.reference.models import damper_modes_hz
 
     while True:
@@ -115,6 +118,8 @@ def damper_geometry(rng) -> tuple[dict, tuple]:
         g["EI"] = np.exp(rng.uniform(np.log(5.0), np.log(60.0)))
         f = damper_modes_hz(g)
         if f[0] >= 4.0 and f[1] <= 60.0:
+            g["alpha_pd"] = np.exp(rng.uniform(np.log(0.5), np.log(6.0)))
+            g["beta_pd"] = np.exp(rng.uniform(np.log(5e-5), np.log(8e-4)))
             return {k: float(v) for k, v in g.items()}, (round(float(0.5 * f[0]), 2), round(float(2.2 * f[1]), 2))
 
 
@@ -168,8 +173,10 @@ def run_case(job: CaseJob) -> dict:
     style = datasets.LabStyle(c.excitation, tuple(c.outputs), c.motion, record_s=job.record_s)
     data = datasets.write_dataset(folder / "data", family, c.withheld, seed=c.seed, periods=PERIODS, style=style,
                                   base=c.base, truth=c.truth or None)
-    # the user describes the damper's geometry; the messenger's EI and damping are what the nominal calibrates
-    described = NominalModel(c.model, {k: v for k, v in c.base.items() if k != "EI"}) if c.base else None
+    # the user describes the damper's geometry; the messenger's EI and damping (the family's linear parameters)
+    # are what the nominal calibrates
+    linear = FAMILY[c.model].linear
+    described = NominalModel(c.model, {k: v for k, v in c.base.items() if k not in linear}) if c.base else None
     written = time.perf_counter() - t0
     try:
         rep = diagnose(c.model, data, folder / "diagnosis", DiagnoseConfig(), job.fmu_dir, workers=1,

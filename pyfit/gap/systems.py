@@ -338,21 +338,22 @@ def _damper_order(name: str) -> int:
     return DAMPER_OUTPUT_ORDER.get(name, 2 if name.startswith(("acc_", "a_")) else 1 if name.startswith("v") else 0)
 
 
-def damper_modal_starts(records, base: dict, modes_of, max_starts: int = 8) -> list[dict]:
-    """Starts that put the model's lowest resonance in the excited band (its lowest resonance when none is in
-    the band: a described damper whose messenger EI is far off) onto each resonance peak the records show
-    (pyfit.analysis.modal.frf_peaks of every output over the clamp displacement, from the whole record and
-    from Welch segments): EI scaled by
-    (f_peak / f_model)^2 (the stiffness matrix is proportional to EI) and the Rayleigh coefficients alpha_pd,
-    beta_pd by zeta_peak / zeta_model (each mode's damping ratio is linear in them). Peaks within 2 % of one
-    already taken are skipped; at most max_starts. modes_of: params -> the model's modes (linearised FMU)."""
+def damper_modal_starts(records, base: dict, modes_of, max_starts: int = 12) -> list[dict]:
+    """Starts that put each of the model's resonances onto each resonance peak the records show
+    (pyfit.analysis.modal.frf_peaks of every output over the clamp displacement, from the whole record and from
+    Welch segments): which mode a peak is cannot be told from the peak alone (a described damper whose EI is
+    far off has its higher modes in the band, or none), so every pairing is a start, the k-th mode on the k-th
+    peak first, and the calibration keeps the best. Each scales EI by (f_peak / f_mode)^2 (the stiffness
+    matrix is proportional to EI) and the Rayleigh coefficients alpha_pd, beta_pd by zeta_peak / zeta_mode,
+    zeta_mode taken at the scaled EI (each mode's damping ratio is linear in them). Peaks within 2 % of one
+    already taken are skipped, starts within 4 % in EI of one already taken too; at most max_starts.
+    modes_of: params -> the model's modes (linearised FMU)."""
     from pyfit.analysis.modal import frf_peaks
     from pyfit.gap.localise import excited_range
 
     lo, hi = excited_range(records)
     modes = modes_of(base)
-    model = [m for m in modes if lo <= m.f_n <= hi] or modes[:1]
-    if not model or "EI" not in base:
+    if not modes or "EI" not in base:
         return []
     peaks = []
     for rec in records:
@@ -362,15 +363,23 @@ def damper_modal_starts(records, base: dict, modes_of, max_starts: int = 8) -> l
                 for p in frf_peaks(u, y, rec.fs, (lo, hi), _damper_order(name), segment_s):
                     if all(abs(p.f_n / q.f_n - 1.0) > 0.02 for q in peaks):
                         peaks.append(p)
+    peaks.sort(key=lambda p: p.f_n)
+    pairings = sorted(((i, j) for i in range(len(modes)) for j in range(len(peaks))),
+                      key=lambda ij: (abs(ij[0] - ij[1]), ij))
     starts = []
-    for p in peaks[:max_starts]:
-        s = dict(base)
-        s["EI"] = base["EI"] * (p.f_n / model[0].f_n) ** 2
-        ratio = float(np.clip(p.zeta / model[0].zeta, 0.2, 5.0))
+    for i, j in pairings:
+        ei = base["EI"] * (peaks[j].f_n / modes[i].f_n) ** 2
+        if any(abs(ei / s["EI"] - 1.0) < 0.04 for s in starts):
+            continue
+        s = {**base, "EI": ei}
+        moved = modes_of(s)
+        ratio = float(np.clip(peaks[j].zeta / moved[i].zeta, 0.2, 5.0)) if len(moved) > i else 1.0
         for n in ("alpha_pd", "beta_pd"):
             if n in s:
                 s[n] = base[n] * ratio
         starts.append(s)
+        if len(starts) == max_starts:
+            break
     return starts
 
 
