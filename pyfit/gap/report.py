@@ -2,6 +2,7 @@
 evidence; what would separate close candidates; report.json, report.md and figures."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import pathlib
 
@@ -219,8 +220,7 @@ def separation(runner, result, records, fits, bands, upsample, lead_periods=1) -
         ya, yb = (sim.simulate(runner, rec, fits[e].params, upsample, lead_periods) for e in (a, b))
         if ya is None or yb is None:
             continue
-        ref = sim.Record(rec.name, rec.level, rec.level_value, rec.fs, rec.inputs, ya, rec.samples_per_period,
-                         rec.weights, rec.derived, rec.first)
+        ref = dataclasses.replace(rec, outputs=ya)
         band = int(np.argmax(localise.by_band(yb, ref, bands)))
         rows.append({"level": rec.level, "input_scale_of": rec.name, "difference_nrmse": localise.nrmse(yb, ref),
                      "band_hz": list(bands[band])})

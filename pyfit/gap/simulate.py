@@ -4,7 +4,7 @@ periods are simulated in front of it and dropped. A failed or diverging run retu
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -32,6 +32,8 @@ class Record:
     weights: dict = field(default_factory=dict)  # output model variable -> weight in the fits (default 1)
     derived: tuple = ()  # inputs derived from the recorded motion (not measured)
     first: int = 0  # samples of a record that does not start at rest, simulated from rest but not compared
+    support: tuple = ()  # (displacement, velocity) inputs of a support motion whose displacement was integrated:
+    # the model is simulated from rest relative to that support (simulate)
 
     def compared(self, name: str) -> np.ndarray:
         """An input over the samples that are compared (from `first` on)."""
@@ -62,7 +64,10 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> R
 
     motion: the model's displacement, velocity and acceleration inputs (e.g. x_base, v_base, a_base): the
     ones not recorded are derived from the recorded one (pyfit.analysis.kinematics, band-limited to the
-    excited band).
+    excited band). A displacement integrated from a velocity or an acceleration has unknown integration
+    constants (the drift removal leaves its start, and the velocity's, off by up to a few per cent of the
+    motion): the model is then simulated from rest relative to its support (Record.support), not from rest
+    with the support displaced, which would ring from that offset.
     Every channel, input and output, is taken less its mean (without_offset): a sensor's zero is neither a
     load nor a motion (the model's equilibrium is the loaded rest position).
     A non-periodic record that does not start at rest (a segment cut from a long record) is simulated from
@@ -90,15 +95,15 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> R
     first = 0 if spp or starts_at_rest(m) else min(int(round(transient_s * m.sample_rate_hz)), n // 4)
     outputs = {k: without_offset(v[first:]) for k, v in m.by_variable("outputs").items()}
     # a file without a `level` label is named by its file in every table and figure
+    support = motion[:2] if motion and motion[0] in derived and not spp else ()  # x integrated
     return Record(m.path.stem, m.level or m.path.stem, float(m.level_value if m.level_value is not None else 0.0),
-                  m.sample_rate_hz, inputs, outputs, spp, weights, derived, first)
+                  m.sample_rate_hz, inputs, outputs, spp, weights, derived, first, support)
 
 
 def scaled(rec: Record, factor: float) -> Record:
     """The same record with its inputs multiplied by factor (outputs unchanged: for predictions only)."""
-    return Record(f"{rec.name}x{factor:g}", f"{rec.level} x{factor:g}", rec.level_value * factor, rec.fs,
-                  {k: v * factor for k, v in rec.inputs.items()}, rec.outputs, rec.samples_per_period, rec.weights,
-                  rec.derived, rec.first)
+    return replace(rec, name=f"{rec.name}x{factor:g}", level=f"{rec.level} x{factor:g}",
+                   level_value=rec.level_value * factor, inputs={k: v * factor for k, v in rec.inputs.items()})
 
 
 # relative error bound of the FMU's adaptive integrator in a diagnosis run: the outputs stay within 1e-4 of their
@@ -119,6 +124,12 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
     params = dict(params)
     delay = params.pop(SENSOR_DELAY, 0.0)  # not an FMU parameter: a lag of the output channels behind the inputs
     inputs, repeat = rec.inputs, 1
+    rigid = None
+    if rec.support:  # from rest relative to the support: its start moved to rest, the outputs moved back
+        xs, vs = rec.support
+        x0, v0 = inputs[xs][0], inputs[vs][0]
+        rigid = (x0 + v0 * np.arange(len(inputs[xs])) / rec.fs, v0)
+        inputs = {**inputs, xs: inputs[xs] - rigid[0], vs: inputs[vs] - v0}
     if rec.periodic:  # one averaged period in: the drive repeats it over the lead and the one period out
         repeat = rec.n // rec.samples_per_period
         inputs = {k: v.reshape(repeat, rec.samples_per_period).mean(axis=0) for k, v in rec.inputs.items()}
@@ -126,8 +137,18 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
                 max(lead_periods, 1) if rec.periodic else 0, tolerance, MAX_WALL_S)
     if not res.ok:
         return None
+    values = res.values if rigid is None else {k: _moved_back(runner, k, v, *rigid) for k, v in res.values.items()}
     return {k: without_offset(delayed(np.tile(v, repeat), rec.fs, delay, rec.periodic)[rec.first:])
-            for k, v in res.values.items()}
+            for k, v in values.items()}
+
+
+def _moved_back(runner: FmuRunner, name: str, values: np.ndarray, x_rigid: np.ndarray, v_rigid: float
+                ) -> np.ndarray:
+    """An output of a run in the frame of the support's rigid start motion (x_rigid [m] over the samples,
+    v_rigid [m/s]) back in the fixed frame: displacements [m] and velocities [m/s] (the FMU's units) move with
+    the frame; accelerations, forces and rotations do not."""
+    unit = runner.variables[name].unit
+    return values + x_rigid if unit == "m" else values + v_rigid if unit == "m/s" else values
 
 
 def residuals(sim: dict | None, rec: Record, penalty: float = 10.0, of=None) -> np.ndarray:
