@@ -226,7 +226,8 @@ def test_a_weak_quadratic_damping_beside_a_strong_cubic_spring_is_named(tmp_path
 
 def test_the_thesis_damper_with_hysteresis_and_softening_springs_is_named_as_both(tmp_path, fmu_dir, measured):
     """The thesis's damper model: Bouc-Wen hysteresis and softening cubic springs, a loop shape drawn at random
-    (not the reference damper's), clamp sweeps recorded as displacement."""
+    (not the reference damper's) and the messenger's EI and damping too (not the FMU's start values), clamp
+    sweeps recorded as displacement."""
     rng = np.random.default_rng(SEED + 2)
     truth = {"k_bw1": float(rng.uniform(400, 800)), "k_bw2": float(rng.uniform(700, 1200)),
              "a_bw": float(rng.uniform(0.1, 0.6)), "beta": float(rng.uniform(0.3, 1.2)),
@@ -234,8 +235,11 @@ def test_the_thesis_damper_with_hysteresis_and_softening_springs_is_named_as_bot
              "D": float(rng.uniform(1.5e-4, 4e-4)),
              "k_cs1": -float(rng.uniform(2e6, 5e6)), "k_cs2": -float(rng.uniform(5e6, 1.2e7))}
     assert _starts_hold_none_of({k: truth[k] for k in ("a_bw", "beta", "gamma", "nu")}, DAMPER_EFFECTS["hysteresis"])
+    # the messenger's EI and Rayleigh damping drawn too: the nominal calibration starts from the FMU's values
+    messenger = {"EI": float(rng.uniform(7.0, 14.0)), "alpha_pd": float(np.exp(rng.uniform(np.log(0.8), np.log(5.0)))),
+                 "beta_pd": float(np.exp(rng.uniform(np.log(8e-5), np.log(5e-4))))}
     data = datasets.write_dataset(tmp_path / "data", datasets.DAMPER, "hysteresis+cubic_stiffness",
-                                  style=datasets.LabStyle("sweep", motion="x"), truth=truth)
+                                  style=datasets.LabStyle("sweep", motion="x"), truth=truth, base=messenger)
     rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
     assert set((rep["chosen_effect"] or "").split(" + ")) == {"hysteresis", "cubic_stiffness"}, rep["verdict"]
     measured("the thesis's damper (hysteresis + softening cubic springs, random loop shape): held-out shrink [%]",

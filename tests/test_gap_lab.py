@@ -11,7 +11,7 @@ from pyfit.gap import diagnose as dg
 from pyfit.io.nominal import load_nominal
 
 ROOT = pathlib.Path(__file__).parents[1]
-# the user's description: known dimensions fixed, EI, alpha_pd, beta_pd uncertain (starts 12, 1.5, 2e-4); the
+# the user's description: known dimensions fixed, EI, alpha_pd, beta_pd uncertain (starts 12, 1.5, 3e-4); the
 # truth keeps the FMU's defaults for those (10 N·m², 2 1/s, 2e-4 s): the calibration has to find them
 SYMMETRIC = load_nominal(ROOT / "configs" / "symmetric_damper.toml")
 
