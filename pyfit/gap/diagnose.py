@@ -567,9 +567,11 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
             screening, strengths = screen(system, fmu, cal, nominal, scale, cfg.upsample, effects)
             screening_path.write_text(json.dumps({"key": key, "fractions": screening, "strengths": strengths},
                                                  indent=1))
-        # the linear system where an amplitude-dependent effect is weakest: the lowest calibration level's
+        # the linear system where an amplitude-dependent effect is weakest: the lowest calibration level's (its
+        # peaks on the calibrated nominal's nearest resonances)
         lowest = min(cal, key=lambda r: r.level_value)
-        linear_starts = tuple(system.data_starts([lowest], lambda p: linear_modes(fmu, p)))
+        linear_starts = tuple(system.data_starts([lowest], lambda p: linear_modes(fmu, p),
+                                                 {n: nominal.params[n] for n in system.linear}))
         clock.end("screening")
         jobs = []
         for name in effects:

@@ -106,7 +106,7 @@ class System:
     linear: tuple  # the nominal model's free parameters
     stiffness: str  # the one of them that a hysteretic element's tangent stiffness replaces in part
     start: callable  # records -> start values of `linear`
-    data_starts: callable  # (records, modes_of) -> other starts of `linear` from the data (see make_system)
+    data_starts: callable  # (records, modes_of, calibrated=None) -> other starts of `linear` from the data (make_system)
     bounds: callable  # (start, softened) -> bounds of `linear`
     scale: callable  # (deflections, fs, nominal params) -> Scale
     effects: dict
@@ -210,9 +210,10 @@ def sdof_start(records) -> dict:
     return {"m": float(abs(m)), "c": float(abs(c)), "k": float(abs(k))}
 
 
-def sdof_file_starts(records, base: dict, modes_of) -> list[dict]:
-    """One FRF start per record (sdof_start of that file alone): with an amplitude-dependent effect, the
-    pooled FRF mixes levels and the file where the effect is weakest gives the linear system."""
+def sdof_file_starts(records, base: dict, modes_of, calibrated: bool = False) -> list[dict]:
+    """One FRF start per record (sdof_start of that file alone, whatever `base` is): with an
+    amplitude-dependent effect, the pooled FRF mixes levels and the file where the effect is weakest gives the
+    linear system."""
     return [{**base, **sdof_start([rec])} for rec in records]
 
 
@@ -338,16 +339,18 @@ def _damper_order(name: str) -> int:
     return DAMPER_OUTPUT_ORDER.get(name, 2 if name.startswith(("acc_", "a_")) else 1 if name.startswith("v") else 0)
 
 
-def damper_modal_starts(records, base: dict, modes_of, max_starts: int = 12) -> list[dict]:
-    """Starts that put each of the model's resonances onto each resonance peak the records show
+def damper_modal_starts(records, base: dict, modes_of, calibrated: bool = False) -> list[dict]:
+    """Starts that put the model's resonances onto the resonance peaks the records show
     (pyfit.analysis.modal.frf_peaks of every output over the clamp displacement, from the whole record and from
-    Welch segments): which mode a peak is cannot be told from the peak alone (a described damper whose EI is
-    far off has its higher modes in the band, or none), so every pairing is a start, the k-th mode on the k-th
-    peak first, and the calibration keeps the best. Each scales EI by (f_peak / f_mode)^2 (the stiffness
-    matrix is proportional to EI) and the Rayleigh coefficients alpha_pd, beta_pd by zeta_peak / zeta_mode,
-    zeta_mode taken at the scaled EI (each mode's damping ratio is linear in them). Peaks within 2 % of one
-    already taken are skipped, starts within 4 % in EI of one already taken too; at most max_starts.
-    modes_of: params -> the model's modes (linearised FMU)."""
+    Welch segments; peaks within 2 % of one already taken skipped). Which mode a peak is cannot be told from
+    the peak alone (a described damper whose EI is far off has its higher modes in the band, or none; the
+    whole-record FRF of a noise record shows spurious peaks), so every pairing of a mode with a peak is a
+    start, the k-th mode on the k-th peak first, and the calibration keeps the best; `calibrated`: `base` is a
+    calibrated model whose modes are near the peaks, and each peak goes onto its nearest mode only. Each
+    scales EI by (f_peak / f_mode)^2 (the stiffness matrix is proportional to EI) and the Rayleigh
+    coefficients alpha_pd, beta_pd by zeta_peak / zeta_mode, zeta_mode taken at the scaled EI (each mode's
+    damping ratio is linear in them); starts within 4 % in EI of one already taken are skipped. modes_of:
+    params -> the model's modes (linearised FMU)."""
     from pyfit.analysis.modal import frf_peaks
     from pyfit.gap.localise import excited_range
 
@@ -364,8 +367,12 @@ def damper_modal_starts(records, base: dict, modes_of, max_starts: int = 12) -> 
                     if all(abs(p.f_n / q.f_n - 1.0) > 0.02 for q in peaks):
                         peaks.append(p)
     peaks.sort(key=lambda p: p.f_n)
-    pairings = sorted(((i, j) for i in range(len(modes)) for j in range(len(peaks))),
-                      key=lambda ij: (abs(ij[0] - ij[1]), ij))
+    if calibrated:
+        pairings = [(min(range(len(modes)), key=lambda i: abs(np.log(p.f_n / modes[i].f_n))), j)
+                    for j, p in enumerate(peaks)]
+    else:
+        pairings = sorted(((i, j) for i in range(len(modes)) for j in range(len(peaks))),
+                          key=lambda ij: (abs(ij[0] - ij[1]), ij))
     starts = []
     for i, j in pairings:
         ei = base["EI"] * (peaks[j].f_n / modes[i].f_n) ** 2
@@ -378,8 +385,6 @@ def damper_modal_starts(records, base: dict, modes_of, max_starts: int = 12) -> 
             if n in s:
                 s[n] = base[n] * ratio
         starts.append(s)
-        if len(starts) == max_starts:
-            break
     return starts
 
 
@@ -437,7 +442,7 @@ class _Family:
     linear: tuple  # the default uncertain parameters
     stiffness: str
     data_start: callable | None  # records -> start values from the data (None: the FMU's defaults)
-    data_starts: callable  # (records, start, modes_of) -> other starts from the data, one per file or peak
+    data_starts: callable  # (records, start, modes_of, calibrated) -> other starts from the data (file, peak)
     bounds: callable
     stiffness_of: callable  # params -> the nonlinear element's nominal stiffness [N/m]
     deflection: callable  # (simulated outputs, record) -> the element's deflection [m]
@@ -480,12 +485,14 @@ def make_system(name: str, defaults: dict, nominal=None) -> System:
         from_data = fam.data_start(records) if fam.data_start else {}
         return {n: given.get(n, from_data.get(n, values[n])) for n in linear}
 
-    def data_starts(records, modes_of) -> list[dict]:
+    def data_starts(records, modes_of, calibrated: dict | None = None) -> list[dict]:
         """Other starts from the data, beside start() (the user's or the FMU's values): the SDOF: each file's
-        FRF; the damper: the model's lowest resonance moved onto each measured peak. modes_of: params -> the
-        model's modes."""
-        base = start(records)
-        found = fam.data_starts(records, {**values, **base}, lambda p: modes_of({**p, **fixed, **fam.switches}))
+        FRF; the damper: the model's resonances moved onto the measured peaks (every pairing; with
+        `calibrated` linear values, around them and each peak onto its nearest resonance). modes_of: params ->
+        the model's modes."""
+        base = calibrated or start(records)
+        found = fam.data_starts(records, {**values, **base}, lambda p: modes_of({**p, **fixed, **fam.switches}),
+                                calibrated is not None)
         return [{n: s[n] for n in linear} for s in found]
 
     def bounds(st: dict, softened: bool = False) -> dict:
