@@ -106,7 +106,7 @@ class System:
     linear: tuple  # the nominal model's free parameters
     stiffness: str  # the one of them that a hysteretic element's tangent stiffness replaces in part
     start: callable  # records -> start values of `linear`
-    data_starts: callable  # (records, modes_of, calibrated=None) -> other starts of `linear` from the data (make_system)
+    data_starts: callable  # (records, modes_of, calibrated=None) -> other starts of `linear` (see make_system)
     bounds: callable  # (start, softened) -> bounds of `linear`
     scale: callable  # (deflections, fs, nominal params) -> Scale
     effects: dict
