@@ -210,7 +210,7 @@ def sdof_start(records) -> dict:
     return {"m": float(abs(m)), "c": float(abs(c)), "k": float(abs(k))}
 
 
-def sdof_file_starts(records, base: dict, modes_of, calibrated: bool = False) -> list[dict]:
+def sdof_file_starts(records, base: dict, modes_of, calibrated: dict | None = None) -> list[dict]:
     """One FRF start per record (sdof_start of that file alone, whatever `base` is): with an
     amplitude-dependent effect, the pooled FRF mixes levels and the file where the effect is weakest gives the
     linear system."""
@@ -339,23 +339,28 @@ def _damper_order(name: str) -> int:
     return DAMPER_OUTPUT_ORDER.get(name, 2 if name.startswith(("acc_", "a_")) else 1 if name.startswith("v") else 0)
 
 
-def damper_modal_starts(records, base: dict, modes_of, calibrated: bool = False) -> list[dict]:
+def damper_modal_starts(records, base: dict, modes_of, calibrated: dict | None = None) -> list[dict]:
     """Starts that put the model's resonances onto the resonance peaks the records show
     (pyfit.analysis.modal.frf_peaks of every output over the clamp displacement, from the whole record and from
     Welch segments; peaks within 2 % of one already taken skipped). Which mode a peak is cannot be told from
     the peak alone (a described damper whose EI is far off has its higher modes in the band, or none; the
     whole-record FRF of a noise record shows spurious peaks), so every pairing of a mode with a peak is a
-    start, the k-th mode on the k-th peak first, and the calibration keeps the best; `calibrated`: `base` is a
-    calibrated model whose modes are near the peaks, and each peak goes onto its nearest mode only. Each
-    scales EI by (f_peak / f_mode)^2 (the stiffness matrix is proportional to EI) and the Rayleigh
-    coefficients alpha_pd, beta_pd by zeta_peak / zeta_mode, zeta_mode taken at the scaled EI (each mode's
-    damping ratio is linear in them); starts within 4 % in EI of one already taken are skipped. modes_of:
-    params -> the model's modes (linearised FMU)."""
+    start, the k-th mode on the k-th peak first, and the calibration keeps the best; `calibrated`: a calibrated
+    model whose modes are near the peaks, and each peak goes onto its nearest mode of it only (its EI is
+    scaled; its damping is not used: a nominal calibrated on records with a strong effect can carry damping
+    far off, and the starts' damping comes from `base`, as do the modes' damping ratios). Each start scales EI by (f_peak / f_mode)^2 (the
+    stiffness matrix is proportional to EI) and `base`'s Rayleigh coefficients alpha_pd, beta_pd by
+    zeta_peak / zeta_mode, zeta_mode taken at the scaled EI (each mode's damping ratio is linear in them);
+    starts within 4 % in EI of one already taken are skipped. modes_of: params -> the model's modes
+    (linearised FMU)."""
     from pyfit.analysis.modal import frf_peaks
     from pyfit.gap.localise import excited_range
 
     lo, hi = excited_range(records)
-    modes = modes_of(base)
+    # the calibrated model names the modes by its EI alone (its damping can be far enough off to leave modes
+    # overdamped)
+    identity = {**base, "EI": calibrated["EI"]} if calibrated and "EI" in base else base
+    modes = modes_of(identity)
     if not modes or "EI" not in base:
         return []
     peaks = []
@@ -375,7 +380,7 @@ def damper_modal_starts(records, base: dict, modes_of, calibrated: bool = False)
                           key=lambda ij: (abs(ij[0] - ij[1]), ij))
     starts = []
     for i, j in pairings:
-        ei = base["EI"] * (peaks[j].f_n / modes[i].f_n) ** 2
+        ei = identity["EI"] * (peaks[j].f_n / modes[i].f_n) ** 2
         if any(abs(ei / s["EI"] - 1.0) < 0.04 for s in starts):
             continue
         s = {**base, "EI": ei}
@@ -488,11 +493,11 @@ def make_system(name: str, defaults: dict, nominal=None) -> System:
     def data_starts(records, modes_of, calibrated: dict | None = None) -> list[dict]:
         """Other starts from the data, beside start() (the user's or the FMU's values): the SDOF: each file's
         FRF; the damper: the model's resonances moved onto the measured peaks (every pairing; with
-        `calibrated` linear values, around them and each peak onto its nearest resonance). modes_of: params ->
-        the model's modes."""
-        base = calibrated or start(records)
-        found = fam.data_starts(records, {**values, **base}, lambda p: modes_of({**p, **fixed, **fam.switches}),
-                                calibrated is not None)
+        `calibrated` linear values, each peak onto its nearest resonance of those). modes_of: params -> the
+        model's modes."""
+        base = {**values, **start(records)}
+        found = fam.data_starts(records, base, lambda p: modes_of({**p, **fixed, **fam.switches}),
+                                None if calibrated is None else {**base, **calibrated})
         return [{n: s[n] for n in linear} for s in found]
 
     def bounds(st: dict, softened: bool = False) -> dict:
