@@ -348,11 +348,11 @@ def damper_modal_starts(records, base: dict, modes_of, calibrated: dict | None =
     start, the k-th mode on the k-th peak first, and the calibration keeps the best; `calibrated`: a calibrated
     model whose modes are near the peaks, and each peak goes onto its nearest mode of it only (its EI is
     scaled; its damping is not used: a nominal calibrated on records with a strong effect can carry damping
-    far off, and the starts' damping comes from `base`, as do the modes' damping ratios). Each start scales EI by (f_peak / f_mode)^2 (the
-    stiffness matrix is proportional to EI) and `base`'s Rayleigh coefficients alpha_pd, beta_pd by
-    zeta_peak / zeta_mode, zeta_mode taken at the scaled EI (each mode's damping ratio is linear in them);
-    starts within 4 % in EI of one already taken are skipped. modes_of: params -> the model's modes
-    (linearised FMU)."""
+    far off, and the starts' damping comes from `base`, as do the modes' damping ratios). Each start scales
+    EI by (f_peak / f_mode)^2 (the stiffness matrix is proportional to EI) and `base`'s Rayleigh coefficients
+    alpha_pd, beta_pd by zeta_peak / zeta_mode, zeta_mode taken at the scaled EI (each mode's damping ratio is
+    linear in them); starts within 4 % in EI of one already taken are skipped. modes_of: params -> the model's
+    modes (linearised FMU)."""
     from pyfit.analysis.modal import frf_peaks
     from pyfit.gap.localise import excited_range
 
