@@ -186,3 +186,28 @@ def test_damper_modal_starts_pair_every_resonance_with_every_peak(fmu_dir, measu
              "truth, relative", abs(around[0]["EI"] / 57.0 - 1), 0.01)
     measured("damper modal starts around a calibrated nominal with 50 x the damping: the first start's lowest "
              "damping ratio vs the truth's, relative", abs(zeta[0] / zeta[1] - 1), 0.25)
+
+
+def test_a_joint_refit_holds_each_seed_it_starts_from():
+    """A member's refit started from the lowest level's linear system can end far from the calibrated nominal
+    (campaign damper case 4: a friction refit with beta_pd 480 x the nominal's, whose rule bounds span a factor
+    10 either way). A joint refit seeded from it must be able to start there: its bounds widen to hold the seed's
+    linear values (clipped into the nominal's, the seed is another model, worse than the member alone), and stay
+    the nominal's when every seed lies inside them."""
+    from pyfit.gap.attribute import Fit, UnitScaling, effect_task
+    from pyfit.gap.systems import Scale, combine
+
+    system = make_system("damper", FMU_DEFAULTS)
+    nominal = Fit("nominal", {**FMU_DEFAULTS, "EI": 10.3, "alpha_pd": 3.7, "beta_pd": 9.8e-7}, ["EI"], 0, 0.2, 1, 1.0)
+    scale = Scale(3e-4, 0.02, 3 * 10.3 / 0.17 ** 3, nominal.params)
+    pair = combine([system.effects["coulomb_friction"], system.effects["hysteresis"]])
+    member = {**nominal.params, "EI": 10.29, "alpha_pd": 1.44, "beta_pd": 4.7e-4, "F_c1": 0.038, "F_c2": 0.058,
+              "v_s": 1e-3}
+    task = effect_task(system, pair, "x.fmu", [], nominal, scale, 10, 1, seeds=(member,))
+    unit = UnitScaling(list(task.start), task.bounds, task.log_scaled)
+    held = unit.values(unit.scaled({**task.start, **task.alternatives[-1]}))
+    assert all(held[n] == pytest.approx(member[n], rel=1e-9) for n in ("EI", "alpha_pd", "beta_pd", "F_c1"))
+    alone = effect_task(system, pair, "x.fmu", [], nominal, scale, 10, 1)
+    assert alone.bounds["beta_pd"][1] < member["beta_pd"] / 40  # the nominal's bounds did not hold it
+    inside = {**member, "alpha_pd": 2.0, "beta_pd": 2e-6}
+    assert effect_task(system, pair, "x.fmu", [], nominal, scale, 10, 1, seeds=(inside,)).bounds == alone.bounds

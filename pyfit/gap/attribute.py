@@ -291,7 +291,8 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
     linear in its strength: it can overshoot), each with the calibrated nominal's linear parameters and with
     each of `linear_starts` (e.g. the linear system estimated from the lowest level, where an
     amplitude-dependent effect is weakest: the nominal's compromise over all levels can be far from it); and
-    `seeds` (parameter values of earlier fits, e.g. each member's own refit for a combination)."""
+    `seeds` (parameter values of earlier fits, e.g. each member's own refit for a combination; the bounds
+    widened to hold a seed's linear values)."""
     start, bounds, fixed = effect_start(system, effect, scale, nominal.params)
     strengths = [{}] + [{n: v * f for n, v in strength.items()} for f in STRENGTH_FACTORS] if strength else [{}]
     shapes = list(effect.starts(scale))
@@ -300,8 +301,15 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
         lin_start, lin_bounds, _ = effect_start(system, effect, scale, nominal.params, linear)
         bounds = {n: (min(bounds[n][0], lin_bounds[n][0]), max(bounds[n][1], lin_bounds[n][1])) for n in bounds}
         alternatives += [{**{n: lin_start[n] for n in system.linear}, **s} for s in strengths + shapes]
-    for seed in seeds:  # clipped into the bounds by the unit scaling
+    for seed in seeds:
         alternatives.append({n: seed[n] for n in start if n in seed})
+        # a seed whose linear values lie outside the bounds (a member's refit from the lowest level's linear
+        # system, far from the nominal) widens them to its own: clipped, it would no longer be the model it is
+        if any(not bounds[n][0] <= seed[n] <= bounds[n][1] for n in system.linear if n in seed):
+            around = _covering(system, [{n: seed.get(n, start[n]) for n in system.linear}],
+                               softened=effect.shift_stiffness > 0)
+            bounds = {n: (min(bounds[n][0], around[n][0]), max(bounds[n][1], around[n][1])) if n in around
+                      else bounds[n] for n in bounds}
     # the effect at zero is the calibrated nominal: the refit keeps it when it ends worse than that
     floor = {**{n: nominal.params[n] for n in system.linear}, **effect.absent(scale)}
     return FitTask(fmu, tuple(records), {**system.nominal_fixed, **fixed}, start, bounds, effect.name,
