@@ -159,7 +159,7 @@ def test_a_short_campaign_on_a_local_dask_cluster(tmp_path, fmu_dir, measured):
     again = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)  # resumes: one case redone
     assert time.perf_counter() - t0 < 0.5 * summary["wall_s"]
     assert summary["resumed"] == 0 and again["resumed"] == 19 and again["wall_s"] < 0.5 * summary["wall_s"]
-    assert "(19 read from an interrupted run)" in (tmp_path / "summary.md").read_text()
+    assert "(19 read from an earlier run)" in (tmp_path / "summary.md").read_text()
     whole = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)  # every case stored: summarised
     assert whole["wall_s"] == again["wall_s"] and whole["resumed"] == 19  # with the wall time of their run
     misses = summary["misses"]  # every effect case's miss judged against its truth

@@ -226,7 +226,8 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     jobs = [CaseJob(c, str(out), str(fmu_dir), record_s) for c in draw(n, seed, model)]
-    # cases an interrupted run finished: read, not diagnosed again, so this run's wall time does not cover them
+    # cases an earlier run finished (interrupted, or a rerun of only some cases): read, not diagnosed again, so this
+    # run's wall time does not cover them
     resumed = sum((out / f"case{j.case.index:04d}" / "outcome.json").is_file() for j in jobs)
     t0 = time.perf_counter()
     if scheduler is None:
@@ -337,7 +338,7 @@ def markdown(s: dict) -> str:
     lines = [f"{s['cases']} {system} cases (seed {s['seed']}, records {s['record_s']:g} s), {s['where']}: wall "
              f"{s['wall_s'] / 60:.1f} min"
              + (f" for the {s['cases'] - s['resumed']} cases this run diagnosed ({s['resumed']} read from an "
-                "interrupted run)" if s.get("resumed") else "")
+                "earlier run)" if s.get("resumed") else "")
              + f", median {s['median_case_s']:.0f} s per case (writing the files and "
              f"diagnosing); command: `{s['command']}`.", "",
              f"Top-1 accuracy on the {s['effect_cases']} cases with a withheld effect: {100 * s['top1']:.0f} %; "
