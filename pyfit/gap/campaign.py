@@ -206,6 +206,14 @@ def run_case(job: CaseJob) -> dict:
     return outcome
 
 
+def stated_with(outcome: dict, calibration: dict | None) -> float | None:
+    """The confidence (a rate, 0-1) the report of a campaign outcome states with `calibration`
+    (pyfit.gap.confidence.stated; None without a calibration or a like report in it)."""
+    chosen = None if outcome["named"] in ("none", "error") else outcome["named"]
+    stated = confidence.stated(outcome["verdict"], chosen, outcome["top_shrink_pct"], calibration)
+    return stated["rate"] if stated else None
+
+
 def command(n: int, seed: int, model: str = "sdof") -> str:
     """The command line that runs this campaign."""
     return f"stockbridge diagnose --campaign {n} --campaign-seed {seed}" + ("" if model == "sdof" else
@@ -241,6 +249,9 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
         outcomes = map_tasks(run_case, jobs, scheduler=scheduler, progress=progress, desc="campaign")
         where = f"Dask scheduler {scheduler}"
     run_by = {"wall_s": time.perf_counter() - t0, "resumed": resumed, "where": where}
+    # every report's confidence as stated with the calibration this run reads (an outcome read from an earlier run
+    # holds the one that run read)
+    outcomes = [{**o, "stated": stated_with(o, stated_from)} for o in outcomes]
     before = out / "summary.json"
     if resumed == n and before.is_file():  # every case stored: summarised again, with the wall time of their run
         run_by = {k: json.loads(before.read_text())[k] for k in run_by}
