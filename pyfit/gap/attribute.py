@@ -252,6 +252,12 @@ def _covering(system: System, starts: list[dict], softened: bool = False) -> dic
     return {n: (min(b[n][0] for b in each), max(b[n][1] for b in each)) for n in each[0]}
 
 
+def _widened(bounds: dict, other: dict) -> dict:
+    """`bounds` widened to hold `other`'s bounds of the parameters both have."""
+    return {n: (min(lo, other[n][0]), max(hi, other[n][1])) if n in other else (lo, hi)
+            for n, (lo, hi) in bounds.items()}
+
+
 def nominal_task(system: System, fmu: str, records: list, budget: int, upsample: int, threads: int = 1) -> FitTask:
     """The nominal (linear) calibration: from the best (time-domain residual) of the system's start (the SDOF:
     the FRF of all files; the damper: the described values), the starts from the data (system.data_starts:
@@ -299,17 +305,15 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
     alternatives = [s for s in strengths if s] + shapes
     for linear in linear_starts:
         lin_start, lin_bounds, _ = effect_start(system, effect, scale, nominal.params, linear)
-        bounds = {n: (min(bounds[n][0], lin_bounds[n][0]), max(bounds[n][1], lin_bounds[n][1])) for n in bounds}
+        bounds = _widened(bounds, lin_bounds)
         alternatives += [{**{n: lin_start[n] for n in system.linear}, **s} for s in strengths + shapes]
     for seed in seeds:
         alternatives.append({n: seed[n] for n in start if n in seed})
         # a seed whose linear values lie outside the bounds (a member's refit from the lowest level's linear
         # system, far from the nominal) widens them to its own: clipped, it would no longer be the model it is
         if any(not bounds[n][0] <= seed[n] <= bounds[n][1] for n in system.linear if n in seed):
-            around = _covering(system, [{n: seed.get(n, start[n]) for n in system.linear}],
-                               softened=effect.shift_stiffness > 0)
-            bounds = {n: (min(bounds[n][0], around[n][0]), max(bounds[n][1], around[n][1])) if n in around
-                      else bounds[n] for n in bounds}
+            bounds = _widened(bounds, _covering(system, [{n: seed.get(n, start[n]) for n in system.linear}],
+                                                softened=effect.shift_stiffness > 0))
     # the effect at zero is the calibrated nominal: the refit keeps it when it ends worse than that
     floor = {**{n: nominal.params[n] for n in system.linear}, **effect.absent(scale)}
     return FitTask(fmu, tuple(records), {**system.nominal_fixed, **fixed}, start, bounds, effect.name,
