@@ -6,13 +6,10 @@ import time
 
 import pytest
 
-from pyfit.build import EXAMPLES, build_fmu
+from pyfit.build import EXAMPLES, LONGEST_BUILDS, build_fmu
 from pyfit.runtime.fmu import FmuRunner
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-
-
-LONGEST_BUILDS = ("ConductorSpan", "StockbridgeDamper", "DamperElement")  # ~30, 19 and 18 s of the ~95 s in all
 
 
 @pytest.fixture(scope="session")

@@ -85,15 +85,33 @@ def test_syntax_error_names_file_and_line_and_builds_nothing(tmp_path):
     assert not out.exists() or not list(out.iterdir())
 
 
-def test_semantic_error_builds_nothing(tmp_path):
+@pytest.mark.parametrize("workers", [1, 2])
+def test_semantic_error_builds_nothing(tmp_path, workers):
+    """An unbalanced model stops the build with the Modelica error, also when it is raised in a build process."""
     lib = tmp_path / "modelica"
     shutil.copytree(LIBRARY, lib)
     bad = lib / "StockbridgeDamper" / "Components" / "SpringDamper.mo"
     bad.write_text(bad.read_text().replace("f = k*s_rel + c*v_rel;", "f = k*s_rel + c*v_rel;\n  f = 2*c*v_rel;"))
     out = tmp_path / "out"
     with pytest.raises(ModelicaError, match="not balanced: 62 equations for 59 unknowns"):
-        build_all(out, ["TwoDOFa"], library=lib)
+        build_all(out, ["TwoDOFa"] * workers, library=lib, workers=workers)
     assert not out.exists() or not list(out.glob("*.fmu"))
+
+
+def test_fmus_built_at_once_are_those_built_one_by_one(fmu_dir, tmp_path):
+    """Two build processes give the FMUs the test run built one at a time (the same GUID: a hash of the interface
+    and the equations; the same state count), reported in the order named."""
+    names = ["CubicSpringElement", "BoucWenElement", "MassSpringDamper"]
+    reported = []
+    results = build_all(tmp_path, names, workers=2, on_built=lambda r: reported.append(r.fmu.stem))
+    assert reported == names and [r.fmu.stem for r in results] == names
+    for r in results:
+        for built in (r.fmu, r.fmu3):
+            assert validate_fmu(str(built)) == []
+        alone = fmu_dir / r.fmu.name
+        assert read_model_description(str(r.fmu)).guid == read_model_description(str(alone)).guid
+        assert read_model_description(str(r.fmu3)).instantiationToken == \
+            read_model_description(str(fmu_dir / "fmi3" / r.fmu.name)).instantiationToken
 
 
 def test_out_of_range_parameter_is_rejected_with_its_range(runner):

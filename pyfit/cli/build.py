@@ -1,6 +1,7 @@
 """stockbridge build: the Modelica library's examples as FMUs."""
 from __future__ import annotations
 
+import os
 import pathlib
 import sys
 
@@ -22,6 +23,8 @@ def add_arguments(ap) -> None:
     ap.add_argument("--with", dest="extra", action="append", default=[], metavar="DIR",
                     help="a folder of your own Modelica packages, loaded beside the library (repeatable); "
                          "name their classes in full")
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+                    help="FMUs built at once, one process each (default: one per core)")
 
 
 def run(args, ap) -> int:
@@ -32,7 +35,7 @@ def run(args, ap) -> int:
         library = [pathlib.Path(args.library), *map(pathlib.Path, args.extra)] if args.extra else \
             pathlib.Path(args.library)
         build_all(pathlib.Path(args.out), args.names or None, library,
-                  on_built=lambda r: print(f"built {r.fmu} and {r.fmu3} ({r.n_states} states)"))
+                  on_built=lambda r: print(f"built {r.fmu} and {r.fmu3} ({r.n_states} states)"), workers=args.workers)
     except (ModelicaError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
