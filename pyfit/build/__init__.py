@@ -17,6 +17,8 @@ __all__ = ["ModelicaError", "EXAMPLES", "LONGEST_BUILDS", "build_fmu", "build_al
 
 # the hand-written C every FMU is compiled with (the FMI 2.0 wrapper with its solvers, the FMI 3.0 adapter)
 C_SOURCES = tuple(sorted(pathlib.Path(__file__).parent.glob("*.c")))
+# the examples whose builds take longest (a large generated C file, or a long Modelica flattening): started first
+LONGEST_BUILDS = ("ConductorSpan", "StockbridgeDamper", "DamperElement")
 
 
 @dataclass
@@ -81,10 +83,6 @@ def build_all(out_dir: pathlib.Path, names: list[str] | None = None, library: pa
         longest_first = sorted(range(len(jobs)), key=lambda i: jobs[i][1] not in LONGEST_BUILDS)
         futures = {i: pool.submit(build_fmu, jobs[i][0], out_dir, jobs[i][1], library) for i in longest_first}
         return [_reported(futures[i].result(), on_built) for i in range(len(jobs))]
-
-
-# the examples whose builds take longest (a large generated C file, or a long Modelica flattening): started first
-LONGEST_BUILDS = ("ConductorSpan", "StockbridgeDamper", "DamperElement")
 
 
 def _reported(result: BuildResult, on_built) -> BuildResult:
