@@ -8,6 +8,7 @@ from pyfit.gap import localise
 
 PENALTY_POINTS = 5.0  # score points charged per strength parameter beyond the first
 CONTROL_SIBLINGS = 3  # extensions of one model needed before the least helpful one serves as a control
+ALIKE = 0.03  # two held-out misfits within 3 % of each other: on the held-out files the models are as good
 
 
 def heldout_nrmse(sims: dict, held) -> float:
@@ -76,12 +77,15 @@ def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, 
                       noise: float = 0.0) -> int:
     """Of two models given as (number of effects, held-out NRMSE), the index (0: a, 1: b) of the one kept: of
     two as large, the lower misfit, but the one with fewer `parameters` (each model's count) when both misfits
-    are at or below `noise` (noise_level: the data tell them apart no more); else the larger only when it adds
-    enough (adds_enough) to the smaller one credited with what refitting on alone buys it (the larger one's
+    are at or below `noise` (noise_level) and its misfit is within ALIKE of the other's (each under the noise,
+    two misfits 20 % apart on the same held-out files still tell the models apart); else the larger only when it
+    adds enough (adds_enough) to the smaller one credited with what refitting on alone buys it (the larger one's
     budget_control, when below its misfit)."""
     if a[0] == b[0]:
         if max(a[1], b[1]) <= noise and parameters[0] != parameters[1]:
-            return 0 if parameters[0] < parameters[1] else 1
+            lean = 0 if parameters[0] < parameters[1] else 1
+            if (a, b)[lean][1] <= (1.0 + ALIKE) * (a, b)[1 - lean][1]:
+                return lean
         return 0 if a[1] <= b[1] else 1
     small, large = (0, 1) if a[0] < b[0] else (1, 0)
     pair = (a, b)
