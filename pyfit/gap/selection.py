@@ -78,7 +78,7 @@ def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, 
     """Of two models given as (number of effects, held-out NRMSE), the index (0: a, 1: b) of the one kept: of
     two as large, the lower misfit, but the one with fewer `parameters` (each model's count) when both misfits
     are at or below `noise` (noise_level) and its misfit is within ALIKE of the other's (each under the noise,
-    two misfits 20 % apart on the same held-out files still tell the models apart); else the larger only when it
+    two misfits further apart on the same held-out files still tell the models apart); else the larger only when it
     adds enough (adds_enough) to the smaller one credited with what refitting on alone buys it (the larger one's
     budget_control, when below its misfit)."""
     if a[0] == b[0]:
