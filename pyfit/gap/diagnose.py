@@ -222,7 +222,7 @@ def _combination_seeds(system, scale, current: dict, members: list, partner_fit:
 
 
 def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, scale, fits: dict, sims: dict, gap,
-                  runner, out: pathlib.Path, key: str, workers, progress):
+                  screening: dict, runner, out: pathlib.Path, key: str, workers, progress):
     """Forward selection while a model's held-out misfit is above the noise (selection.significant with
     `cfg.combination_min_gap`), from each of the `cfg.beam` best single effects (by score; a flexible stand-in
     can lead, the true first member come second): extend the model by each of the `cfg.partners` other effects
@@ -246,7 +246,11 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     A path's end is checked backward: the model without its last-added member is refitted from the end's
     values, and the end is kept only when it still removes `min_excess_cut` of what that refit leaves; an end
     still above the absolute criterion is then refitted on from its own values. A path whose start is a member
-    of an earlier path's end that explains the data (and is no possible stand-in) is not tried. Of the ends of
+    of an earlier path's end that explains the data (and is no possible stand-in: a model with a free-shape
+    member, systems.Effect.free_shape, still above the noise) is not tried. When a path ends at a possible
+    stand-in, the single effect whose sensitivity explains most of the nominal residual (`screening`: the share
+    per effect) starts a path too, if none has yet: a loop can take up a strong spring's refit score where the
+    spring's sensitivity still shows it, and the loop beside the spring's refit is found on that path. Of the ends of
     these paths, a larger model is selected only by the same rule, and of two as large whose misfits are both
     within the noise, the one with fewer parameters (selection.simpler_or_better). When then no single effect
     and not the model selected meets the absolute criterion, the `cfg.grid_models` models with the lowest
@@ -425,8 +429,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             parameters=(len(effects[a].params), len(effects[b].params)),
             noise=selection.noise_level(above, cfg.noise_factor, cfg.combination_min_gap))]
 
-    def stand_in(name):  # a free-shape loop (one with basins) still above the noise: it may hold another's part
-        return effects[name].basin is not None and left(name)
+    def stand_in(name):  # a free-shape loop still above the noise: it may hold another's part
+        return any(system.effects[m].free_shape for m in effects[name].members or (name,)) and left(name)
 
     def polished(end):
         # a path's end still above the absolute criterion, refitted on from its own values with twice a refit's
@@ -436,12 +440,15 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             onward(end, fits[end].params, 2 * cfg.refit_budget, f"{_stem(end)}.polished")
         return end
 
-    ends = []
-    for start in ranked[:cfg.beam]:
+    ends, starts = [], ranked[:cfg.beam]
+    screened = max((n for n in ranked if not effects[n].members), key=lambda n: screening.get(n, 0.0))
+    for start in starts:
         if any(after[e] <= explained_below and start in (effects[e].members or (e,)) and not stand_in(e)
                for e in ends):
             break  # an earlier path's end explains the data and holds this start already
         ends.append(polished(grow(start)))
+        if stand_in(ends[-1]) and screened not in starts:
+            starts.append(screened)  # the effect the loop may stand in for, by its sensitivity
         if not left(ends[-1]) or (ends[-1] in settled and not stand_in(ends[-1])):
             break  # a path that reaches the noise, or explains the data with nothing a candidate explains left
         # (not so a free-shape loop still above the noise: it can take up a strong spring's part beyond the reach
@@ -587,8 +594,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
             sims[name] = {r.name: sim.simulate(runner, r, f.params, cfg.upsample, system.lead_periods)
                           for r in held}
         clock.end("refits with each effect")
-        system, selected = _combinations(system, cfg, fmu, cal, held, nominal, scale, fits, sims, gap, runner, out,
-                                         key, workers, progress)
+        system, selected = _combinations(system, cfg, fmu, cal, held, nominal, scale, fits, sims, gap, screening,
+                                         runner, out, key, workers, progress)
         clock.end("combinations of effects")
     result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
                              selected)

@@ -86,6 +86,12 @@ class Effect:
         """How many strength (not shape) parameters the effect adds: what the ranking's score charges for."""
         return sum(not p.shape for p in self.params)
 
+    @property
+    def free_shape(self) -> bool:
+        """Whether the effect fits a shape of its own (two or more shape parameters: a hysteresis loop's), with
+        which it can take up part of another effect (a loop stiffening as a hardening spring does)."""
+        return sum(p.shape for p in self.params) >= 2
+
     def absent(self, scale: Scale) -> dict:
         """Parameter values at which the effect is not there (the nominal model): strengths at zero where their
         range holds it, shape parameters and deviations (e.g. the mass offsets) at their start."""
