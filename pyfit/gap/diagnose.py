@@ -248,9 +248,11 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     still above the absolute criterion is then refitted on from its own values. A path whose start is a member
     of an earlier path's end that explains the data (and is no possible stand-in: a model with a free-shape
     member, systems.Effect.free_shape, still above the noise) is not tried. When a path ends at a possible
-    stand-in, the single effect whose sensitivity explains most of the nominal residual (`screening`: the share
-    per effect) starts a path too, if none has yet: a loop can take up a strong spring's refit score where the
-    spring's sensitivity still shows it, and the loop beside the spring's refit is found on that path. Of the ends of
+    stand-in whose loop has no basins (the damper's: its refit descends from a list of starts), the single effect
+    whose sensitivity explains most of the nominal residual (`screening`: the share per effect) starts a path
+    too, if none has yet: such a loop can take up a strong spring's refit score where the spring's sensitivity
+    still shows it, and the loop beside the spring's refit is found on that path (a loop with basins is refitted
+    from each, a weak loop's among them). Of the ends of
     these paths, a larger model is selected only by the same rule, and of two as large whose misfits are both
     within the noise, the one with fewer parameters (selection.simpler_or_better). When then no single effect
     and not the model selected meets the absolute criterion, the `cfg.grid_models` models with the lowest
@@ -447,7 +449,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                for e in ends):
             break  # an earlier path's end explains the data and holds this start already
         ends.append(polished(grow(start)))
-        if stand_in(ends[-1]) and screened not in starts:
+        if stand_in(ends[-1]) and effects[ends[-1]].basin is None and screened not in starts:
             starts.append(screened)  # the effect the loop may stand in for, by its sensitivity
         if not left(ends[-1]) or (ends[-1] in settled and not stand_in(ends[-1])):
             break  # a path that reaches the noise, or explains the data with nothing a candidate explains left
