@@ -443,7 +443,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         return end
 
     ends, starts = [], ranked[:cfg.beam]
-    screened = max((n for n in ranked if not effects[n].members), key=lambda n: screening.get(n, 0.0))
+    screened = max(ranked, key=lambda n: screening.get(n, 0.0))  # the single effects, by their sensitivity
     for start in starts:
         if any(after[e] <= explained_below and start in (effects[e].members or (e,)) and not stand_in(e)
                for e in ends):
