@@ -165,6 +165,11 @@ def test_the_summary_tells_misses_the_data_cannot_decide_from_misses_of_the_sear
                               "command": "c"})
     assert "(the data do not favour the truth) | 1 |" in text and "by the data: 33 %." in text
     assert "1.35 × the calibrated nominal's" in text
+    # resumed into a folder whose earlier runs took 90 min: this run's 6 min and theirs bound a full run
+    text = campaign.markdown({**s, "cases": 8, "seed": 0, "record_s": 6.0, "where": "here", "wall_s": 360.0,
+                              "resumed": 5, "earlier_wall_s": 5400.0, "command": "c"})
+    assert ("wall 6.0 min for the 3 cases this run diagnosed (5 read from an earlier run, whose runs took 90.0 min: "
+            "a full run takes at most 96.0 min)") in text
 
 
 @pytest.mark.slow
@@ -179,7 +184,9 @@ def test_a_short_campaign_on_a_local_dask_cluster(tmp_path, fmu_dir, measured):
     again = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)  # resumes: one case redone
     assert time.perf_counter() - t0 < 0.5 * summary["wall_s"]
     assert summary["resumed"] == 0 and again["resumed"] == 19 and again["wall_s"] < 0.5 * summary["wall_s"]
-    assert "(19 read from an earlier run)" in (tmp_path / "summary.md").read_text()
+    assert again["earlier_wall_s"] == summary["wall_s"]  # a full run's wall time at most the two runs'
+    assert (f"(19 read from an earlier run, whose runs took {summary['wall_s'] / 60:.1f} min: a full run takes at "
+            f"most {(summary['wall_s'] + again['wall_s']) / 60:.1f} min)") in (tmp_path / "summary.md").read_text()
     whole = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)  # every case stored: summarised
     assert whole["wall_s"] == again["wall_s"] and whole["resumed"] == 19  # with the wall time of their run
     misses = summary["misses"]  # every effect case's miss judged against its truth

@@ -2,15 +2,17 @@
 do not hold: truths drawn at random across the family (a generator independent of the FMUs: the CasADi
 reference integrated by CVODES), never at a start value of the candidate. Slow: `pytest -m slow`."""
 import json
+import pathlib
 
 import numpy as np
 import pytest
 
-from pyfit.gap import campaign, datasets
+from pyfit.gap import campaign, datasets, selection
 from pyfit.gap import diagnose as dg
 from pyfit.gap.systems import DAMPER_EFFECTS, SDOF_EFFECTS, Scale
 
 pytestmark = pytest.mark.slow
+ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 SEED = 20261125  # the truths of this file: each test draws its own from this seed, whatever ran before it
 
@@ -160,13 +162,14 @@ def test_a_weak_loop_beside_a_strong_cubic_spring_is_named_as_both(tmp_path, fmu
 
 
 def _campaign_case_named(tmp_path, fmu_dir, seed: int, index: int, withheld: str, excitation: str,
-                         model: str = "sdof"):
+                         model: str = "sdof", cfg: dg.DiagnoseConfig | None = None):
     """Case `index` of the `model` campaign's draw with `seed` (its withheld effects and excitation checked),
-    written and diagnosed as the campaign does; asserts it is named right; returns the case and the report's best
-    model."""
+    written and diagnosed as the campaign does (with `cfg`: default settings); asserts it is named right; returns
+    the case and the report's best model."""
     case = campaign.draw(index + 1, seed=seed, model=model)[index]
     assert case.withheld == withheld and case.excitation == excitation
-    outcome = campaign.run_case(campaign.CaseJob(case, str(tmp_path), fmu_dir, campaign.RECORD_S))
+    outcome = campaign.run_case(campaign.CaseJob(case, str(tmp_path), fmu_dir, campaign.RECORD_S,
+                                                 cfg or dg.DiagnoseConfig()))
     assert outcome["named"] == withheld, outcome["verdict"]
     report = tmp_path / f"case{index:04d}" / "diagnosis" / "report.json"
     return case, json.loads(report.read_text())["ranking"][0]
@@ -269,3 +272,31 @@ def test_a_weak_sharp_loop_softening_on_both_branches_is_named(tmp_path, fmu_dir
     case, best = _campaign_case_named(tmp_path, fmu_dir, 17, 132, "hysteresis", "sweep")
     measured("SDOF with a weak, sharp loop softening on both branches under sweeps: fitted alpha relative to the "
              "withheld value", abs(best["params"]["alpha"] / case.truth["alpha"] - 1), 0.01)
+
+
+def test_an_effect_under_the_noise_threshold_is_told_from_noise_by_its_refit(tmp_path, fmu_dir, measured):
+    """A weak quadratic damping under a sweep recorded as displacement (a case of the check campaign's draw,
+    CasADi reference): the nominal's held-out misfit is within the noise threshold, but with refit_within_noise
+    the damping's refit removes part of it on the held-out files, where a refit of noise alone carries nothing
+    over; the damping is named and c2 recovered."""
+    case, best = _campaign_case_named(tmp_path, fmu_dir, 19, 18, "quadratic_damping", "sweep",
+                                      cfg=dg.load_config(ROOT / "configs" / "diagnose_within_noise.toml"))
+    gap = json.loads((tmp_path / "case0018" / "diagnosis" / "report.json").read_text())["gap"]
+    assert gap["overall"] <= selection.noise_level(gap["noise_floor"], dg.DiagnoseConfig().noise_factor,
+                                                   dg.DiagnoseConfig().min_gap)  # under the nominal's own test
+    measured("SDOF with a quadratic damping under the noise threshold: share of the nominal's held-out misfit its "
+             "refit removes", gap["detection"]["cut"], dg.DiagnoseConfig().min_detect_cut, at_least=True)
+    measured("SDOF with a quadratic damping under the noise threshold: fitted c2 relative to the withheld value",
+             abs(best["params"]["c2"] / case.truth["c2"] - 1), 0.05)
+
+
+def test_noise_alone_refitted_below_the_noise_threshold_is_no_gap(tmp_path, fmu_dir, measured):
+    """A null case of the check campaign's draw (nothing withheld; CasADi reference) with refit_within_noise: every
+    single effect is refitted, and the best of them removes less of the held-out misfit than min_detect_cut (what
+    a refit fits of the calibration files' noise does not carry over to the held-out files): no gap."""
+    _campaign_case_named(tmp_path, fmu_dir, 19, 4, "none", "stepped_sine",
+                         cfg=dg.load_config(ROOT / "configs" / "diagnose_within_noise.toml"))
+    gap = json.loads((tmp_path / "case0004" / "diagnosis" / "report.json").read_text())["gap"]
+    assert not gap["detection"]["detected"]
+    measured("SDOF null case refitted below the noise threshold: share of the held-out misfit the best refit "
+             "removes", gap["detection"]["cut"], dg.DiagnoseConfig().min_detect_cut)

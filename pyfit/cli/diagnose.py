@@ -78,7 +78,7 @@ def run(args, ap) -> int:
             return 0
         if args.campaign:
             campaign.run(args.campaign, args.out, args.fmus, args.campaign_seed, args.workers or 2, args.scheduler,
-                         calibrate=args.calibrate, model=args.model)
+                         calibrate=args.calibrate, model=args.model, config=args.config)
             print((pathlib.Path(args.out) / "summary.md").read_text())
             return 0
         cfg = load_config(args.config) if args.config else None

@@ -24,12 +24,12 @@ import dataclasses
 import json
 import pathlib
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
 from pyfit.gap import confidence, datasets
-from pyfit.gap.diagnose import DiagnoseConfig, diagnose, misfit_at
+from pyfit.gap.diagnose import DiagnoseConfig, diagnose, load_config, misfit_at
 from pyfit.gap.systems import FAMILY
 from pyfit.io.nominal import NominalModel
 from pyfit.runtime.batch import map_tasks
@@ -156,6 +156,7 @@ class CaseJob:
     out: str
     fmu_dir: str
     record_s: float
+    cfg: DiagnoseConfig = field(default_factory=DiagnoseConfig)  # the diagnosis's settings
 
 
 def run_case(job: CaseJob) -> dict:
@@ -179,7 +180,7 @@ def run_case(job: CaseJob) -> dict:
     described = NominalModel(c.model, {k: v for k, v in c.base.items() if k not in linear}) if c.base else None
     written = time.perf_counter() - t0
     try:
-        rep = diagnose(c.model, data, folder / "diagnosis", DiagnoseConfig(), job.fmu_dir, workers=1,
+        rep = diagnose(c.model, data, folder / "diagnosis", job.cfg, job.fmu_dir, workers=1,
                        progress=False, nominal=described)
         named, gap = rep["chosen_effect"], rep["gap"]
         top = rep["ranking"][0]["shrink_pct"] if rep["ranking"] else None
@@ -191,8 +192,8 @@ def run_case(job: CaseJob) -> dict:
         # nominal's others), against which a miss is one the data cannot decide or one of the search
         truth = json.loads((data / "truth.json").read_text())
         outcome["member_to_noise"] = truth["member_to_noise"]
-        at_truth = misfit_at(c.model, data, {**rep["nominal"]["params"], **truth["params"]}, fmu_dir=job.fmu_dir,
-                             nominal=described)
+        at_truth = misfit_at(c.model, data, {**rep["nominal"]["params"], **truth["params"]}, job.cfg,
+                             fmu_dir=job.fmu_dir, nominal=described)
         outcome.update(truth_held_out=at_truth.held_out, truth_calibration=at_truth.calibration,
                        named_held_out=next((d["heldout_gap_after"] for d in rep["ranking"] if d["effect"] == named),
                                            gap["overall"]),
@@ -214,26 +215,31 @@ def stated_with(outcome: dict, calibration: dict | None) -> float | None:
     return stated["rate"] if stated else None
 
 
-def command(n: int, seed: int, model: str = "sdof") -> str:
+def command(n: int, seed: int, model: str = "sdof", config: str | None = None) -> str:
     """The command line that runs this campaign."""
-    return f"stockbridge diagnose --campaign {n} --campaign-seed {seed}" + ("" if model == "sdof" else
-                                                                           f" --model {model}")
+    return (f"stockbridge diagnose --campaign {n} --campaign-seed {seed}" + ("" if model == "sdof" else
+                                                                            f" --model {model}")
+            + (f" --config {config}" if config else ""))
 
 
 def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=None, record_s: float = RECORD_S,
-        progress: bool = True, calibrate: bool = False, model: str = "sdof") -> dict:
+        progress: bool = True, calibrate: bool = False, model: str = "sdof", config: str | None = None) -> dict:
     """Draw n cases of `model` and diagnose them: on `scheduler` (a Dask scheduler address) when given, else on
     a Dask LocalCluster of `workers` single-threaded processes. Writes OUT/summary.md and OUT/summary.json (a
     campaign whose every case is stored is summarised again, with the wall time of the run that diagnosed them);
     with `calibrate` (SDOF cases only: the confidence is stated for SDOF diagnoses), its hit rates become the
-    package's confidence calibration (pyfit.gap.confidence)."""
+    package's confidence calibration (pyfit.gap.confidence); `config`: a TOML file of diagnosis settings
+    (pyfit.gap.diagnose.load_config; default: the defaults, which the calibration is of)."""
+    if calibrate and config:
+        raise ValueError("--calibrate: the package's calibration is of the default diagnosis settings; drop --config")
     if calibrate and model != confidence.FAMILY:
         raise ValueError(f"--calibrate: the package's calibration is of {confidence.FAMILY} cases; the campaign "
                          f"is of {model}")
     stated_from = confidence.load() if model == confidence.FAMILY else None
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    jobs = [CaseJob(c, str(out), str(fmu_dir), record_s) for c in draw(n, seed, model)]
+    cfg = load_config(config) if config else DiagnoseConfig()
+    jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg) for c in draw(n, seed, model)]
     # cases an earlier run finished (interrupted, or a rerun of only some cases): read, not diagnosed again, so this
     # run's wall time does not cover them
     resumed = sum((out / f"case{j.case.index:04d}" / "outcome.json").is_file() for j in jobs)
@@ -249,14 +255,22 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
         outcomes = map_tasks(run_case, jobs, scheduler=scheduler, progress=progress, desc="campaign")
         where = f"Dask scheduler {scheduler}"
     run_by = {"wall_s": time.perf_counter() - t0, "resumed": resumed, "where": where}
+    before = out / "summary.json"
+    if 0 < resumed < n and before.is_file():
+        # the resumed cases were diagnosed by the run that wrote the summary before (and those it read by the ones
+        # before it): with this run's, a full run's wall time at most
+        earlier = json.loads(before.read_text())
+        if earlier.get("cases") == n:
+            run_by["earlier_wall_s"] = earlier["wall_s"] + earlier.get("earlier_wall_s", 0.0)
     # every report's confidence as stated with the calibration this run reads (an outcome read from an earlier run
     # holds the one that run read)
     outcomes = [{**o, "stated": stated_with(o, stated_from)} for o in outcomes]
-    before = out / "summary.json"
     if resumed == n and before.is_file():  # every case stored: summarised again, with the wall time of their run
-        run_by = {k: json.loads(before.read_text())[k] for k in run_by}
+        earlier = json.loads(before.read_text())
+        run_by = {k: earlier[k] for k in ("wall_s", "resumed", "where", "earlier_wall_s") if k in earlier}
     summary = summarise(outcomes)
-    summary.update({"cases": n, "seed": seed, "record_s": record_s, **run_by, "command": command(n, seed, model),
+    summary.update({"cases": n, "seed": seed, "record_s": record_s, **run_by,
+                    "command": command(n, seed, model, config),
                     "model": model,
                     "stated_from": {k: stated_from[k] for k in ("source", "seed", "cases")} if stated_from else None})
     if calibrate:
@@ -349,7 +363,9 @@ def markdown(s: dict) -> str:
     lines = [f"{s['cases']} {system} cases (seed {s['seed']}, records {s['record_s']:g} s), {s['where']}: wall "
              f"{s['wall_s'] / 60:.1f} min"
              + (f" for the {s['cases'] - s['resumed']} cases this run diagnosed ({s['resumed']} read from an "
-                "earlier run)" if s.get("resumed") else "")
+                "earlier run" + (f", whose runs took {s['earlier_wall_s'] / 60:.1f} min: a full run takes at most "
+                                 f"{(s['wall_s'] + s['earlier_wall_s']) / 60:.1f} min" if s.get("earlier_wall_s")
+                                 else "") + ")" if s.get("resumed") else "")
              + f", median {s['median_case_s']:.0f} s per case (writing the files and "
              f"diagnosing); command: `{s['command']}`.", "",
              f"Top-1 accuracy on the {s['effect_cases']} cases with a withheld effect: {100 * s['top1']:.0f} %; "

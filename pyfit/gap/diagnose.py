@@ -58,9 +58,15 @@ class DiagnoseConfig:
     # candidate's sensitivity explains this share of its calibration residual (the screening at that model)
     grid_models: int = 3  # when no model meets the absolute criterion: the best ones by held-out misfit, each
     # refitted from the best point of a grid over its members' strengths (systems.strength_grid)
+    refit_within_noise: bool = False  # refit the single effects also when the nominal's held-out misfit is
+    # within the noise threshold (an effect too weak for the nominal's test told from noise by its refit)
+    min_detect_cut: float = 0.05  # with refit_within_noise: the gap counts when a single effect's refit removes
+    # this share of the held-out misfit (selection.detected_by_refit; against the nominal's and against the refit's
+    # own linear values with the effect at zero)
 
 
 _SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
+                   bool if f.name == "refit_within_noise" else
                    int if f.name in ("nominal_budget", "refit_budget", "upsample", "max_effects", "partners",
                                  "combination_probes", "grid_models")
                    else "number"), False, f.default)
@@ -469,6 +475,22 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     return dataclasses.replace(system, effects=effects), selected
 
 
+def _detection(system, fits: dict, sims: dict, held, gap: dict, scale, runner, cfg: DiagnoseConfig) -> dict:
+    """Whether the single effects' refits find a gap the nominal's held-out misfit left within the noise
+    threshold: the refit that leaves the least held-out misfit, against the nominal's and against that refit's
+    own linear values with its effect at zero (what refitting the linear parameters alone buys), by
+    selection.detected_by_refit with `cfg.min_detect_cut`."""
+    after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
+    best = min(after, key=after.get)
+    absent = {**fits[best].params, **system.effects[best].absent(scale)}
+    linear_only = selection.heldout_nrmse(
+        {r.name: sim.simulate(runner, r, absent, cfg.upsample, system.lead_periods) for r in held}, held)
+    before = min(gap["overall"], linear_only)
+    return {"effect": best, "heldout_after": after[best], "linear_only": linear_only,
+            "cut": 1.0 - after[best] / before if before > 0 else 0.0, "min_cut": cfg.min_detect_cut,
+            "detected": selection.detected_by_refit(before, after[best], cfg.min_detect_cut)}
+
+
 def fmu_defaults(runner: FmuRunner) -> dict[str, float]:
     """The FMU's parameter start values (the .mo defaults), SI."""
     return {v.name: float(v.start) for v in runner.model_description.modelVariables
@@ -492,7 +514,9 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
              candidates=None) -> dict:
     """Diagnose the dataset against the nominal model `model` ('sdof' or 'damper'); writes OUT/report.json,
     OUT/report.md and figures; returns the report. When the nominal model already fits the held-out files
-    within the noise floor, no effect is refitted (verdict 'no significant gap').
+    within the noise threshold, the verdict is 'no significant gap' unless cfg.refit_within_noise: then the single
+    effects are refitted all the same, and the gap is significant when the best of them removes
+    cfg.min_detect_cut of the held-out misfit.
 
     nominal: the user's description of the nominal model (a NominalModel or a TOML file, see
     pyfit.io.nominal); None: the FMU's defaults (for the damper, the theory §1.3 reference damper).
@@ -533,7 +557,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     (out / "fits").mkdir(parents=True, exist_ok=True)
     judging = ("min_gap", "noise_factor", "close_points", "min_shrink_pct", "explain_factor", "explain_margin",
                "nominal_max_nrmse", "max_effects", "partners", "min_excess_cut", "beam", "combination_min_gap",
-               "min_partner_explained", "grid_models")
+               "min_partner_explained", "grid_models", "min_detect_cut", "refit_within_noise")
     # (how results are judged and which combinations are tried, not how a fit is made: stored fits stay valid)
     settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in judging}, sort_keys=True)
     description = json.dumps({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}
@@ -564,10 +588,12 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     clock.end("where (nominal gap)")
     screening, fits, selected = {}, {}, None
     effects = cfg.effects or list(system.effects)
-    # nothing to attribute when the nominal model fits the held-out files within their noise. When it fits none
-    # of its own calibration files the effects are refitted all the same: a strong amplitude-dependent effect
-    # leaves no linear model fitting any level, and the verdict is "does not fit" only if no effect fits either
-    if gap["significant"]:
+    # nothing to attribute when the nominal model fits the held-out files within the noise threshold, unless
+    # cfg.refit_within_noise: an effect too weak for that threshold is still told from noise when its refit removes
+    # part of the held-out misfit (below). When the nominal fits none of its own calibration files the effects are
+    # refitted all the same: a strong amplitude-dependent effect leaves no linear model fitting any level, and the
+    # verdict is "does not fit" only if no effect fits either
+    if gap["significant"] or cfg.refit_within_noise:
         screening_path = out / "fits" / "screening.json"
         stored = json.loads(screening_path.read_text()) if screening_path.is_file() else {}
         if stored.get("key") == key and "strengths" in stored:
@@ -596,8 +622,12 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
             sims[name] = {r.name: sim.simulate(runner, r, f.params, cfg.upsample, system.lead_periods)
                           for r in held}
         clock.end("refits with each effect")
-        system, selected = _combinations(system, cfg, fmu, cal, held, nominal, scale, fits, sims, gap, screening,
-                                         runner, out, key, workers, progress)
+        if not gap["significant"]:
+            gap["detection"] = _detection(system, fits, sims, held, gap, scale, runner, cfg)
+            gap["significant"] = gap["detection"]["detected"]
+        if gap["significant"]:
+            system, selected = _combinations(system, cfg, fmu, cal, held, nominal, scale, fits, sims, gap,
+                                             screening, runner, out, key, workers, progress)
         clock.end("combinations of effects")
     result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
                              selected)

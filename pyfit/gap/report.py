@@ -93,6 +93,22 @@ def best_refit(fits: dict) -> tuple[float, str]:
     return min(((f.calibration_nrmse, name) for name, f in fits.items()), default=(float("inf"), ""))
 
 
+def _detection_lines(gap: dict, cfg) -> list[str]:
+    """What the single refits said of a nominal misfit within the noise threshold (gap["detection"], set by the
+    diagnosis when the nominal's test found no gap)."""
+    d = gap.get("detection")
+    if not d:
+        return []
+    threshold = selection.noise_level(gap["noise_floor"], cfg.noise_factor, cfg.min_gap)
+    told = (f"the nominal's held-out NRMSE {gap['overall']:.4f} is within the noise threshold {threshold:.4f}; the "
+            f"refit with {d['effect']} leaves {d['heldout_after']:.4f} (its linear values with the effect at zero "
+            f"{d['linear_only']:.4f}): it removes {100 * d['cut']:.1f} % of the held-out misfit")
+    if d["detected"]:
+        return [told + f", at least {100 * d['min_cut']:.0f} %: a gap below the threshold (a refit of noise alone "
+                "carries nothing over to the held-out files)"]
+    return [told + f", under the {100 * d['min_cut']:.0f} % that tells an effect from noise: no effect shows"]
+
+
 def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
              selected: str | None = None) -> dict:
     """The report: verdict, chosen effect, gap (where), ranking (which, how far), evidence. `selected`: the
@@ -192,7 +208,7 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
             evidence.append("detection lines: odd misfit {:.2e} (noise {:.2e}), even misfit {:.2e} (noise {:.2e})"
                             .format(h["odd_detection"]["misfit"], h["odd_detection"]["noise"],
                                     h["even_detection"]["misfit"], h["even_detection"]["noise"]))
-    evidence = amplitude_note + evidence
+    evidence = amplitude_note + _detection_lines(gap, cfg) + evidence
     listed_starts = {name: [d for d in [{p.name: p.range(scale)[1] for p in e.params if p.shape}] if d]
                      + list(e.starts(scale))
                      for name, e in system.effects.items() if name in fits and e.starts(scale) and not e.members}
@@ -380,7 +396,10 @@ def markdown(result: dict) -> str:
     for name, starts in result.get("listed_starts", {}).items():
         lines += ["", f"{name}: besides the screening's strengths, the refit began from the best of these "
                   f"{len(starts)} starts on the calibration files, then fitted every parameter: {starts_text(starts)}."]
-    if result["ranking"]:
+    if result["ranking"] and result["verdict"] == "no significant gap":
+        lines += ["", "The single effects were refitted to test for an effect below the noise threshold; none "
+                  "removes enough of the held-out misfit to tell it from noise (Evidence)."]
+    elif result["ranking"]:
         lines += ["", "Score = shrink − 5 points per added strength parameter beyond the first (shape parameters "
                   "are not charged). "
                   "Shrink = (gap before − gap after) / (gap before − reference), reference = the smaller of the "

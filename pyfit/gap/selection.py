@@ -34,6 +34,13 @@ def explained_below(floor: float, explain_factor: float, explain_margin: float) 
     return max(explain_factor * floor, floor + explain_margin)
 
 
+def detected_by_refit(before: float, after: float, min_cut: float) -> bool:
+    """Whether a refit finds a gap below the noise threshold: it removes at least `min_cut` (a share, 0-1) of the
+    held-out misfit `before` (the nominal's, or its refit's linear values alone when lower). The held-out files'
+    noise is independent of the calibration files', so a refit fitting that noise carries nothing over to them."""
+    return before > 0 and after <= (1.0 - min_cut) * before
+
+
 def shrink_pct(before: float, after: float, reference: float) -> float:
     """How much of the gap above `reference` a model removes, in %: 100 (before - after) / (before - reference)."""
     return 100.0 * (before - after) / (before - reference) if before > reference else 0.0

@@ -82,6 +82,20 @@ RESULTS = {
     "docs/results/campaign_damper.md": ("results/campaign_damper/summary.md",
                                         "stockbridge diagnose --campaign 30 --model damper --out "
                                         "results/campaign_damper"),
+    # the same campaigns with the refits below the noise threshold (each run into a copy of the campaign above
+    # with its 'no significant gap' cases removed, files, fits and outcomes: the only cases the setting changes)
+    "docs/results/campaign_within_noise.md": ("results/campaign_within_noise/summary.md",
+                                              "stockbridge diagnose --campaign 200 --campaign-seed 18 --config "
+                                              "configs/diagnose_within_noise.toml --out "
+                                              "results/campaign_within_noise"),
+    "docs/results/campaign_check_within_noise.md": ("results/campaign_check_within_noise/summary.md",
+                                                    "stockbridge diagnose --campaign 100 --campaign-seed 19 "
+                                                    "--config configs/diagnose_within_noise.toml --out "
+                                                    "results/campaign_check_within_noise"),
+    "docs/results/campaign_damper_within_noise.md": ("results/campaign_damper_within_noise/summary.md",
+                                                     "stockbridge diagnose --campaign 30 --model damper --config "
+                                                     "configs/diagnose_within_noise.toml --out "
+                                                     "results/campaign_damper_within_noise"),
     "docs/results/bench_peers_fit.md": ("results/bench/peers_fit.md", "python bench/peers_fit.py --seeds 3"),
     "docs/results/bench_peers_diagnosis.md": ("results/bench/peers_diagnosis_quick.md",
                                               "python bench/peers_diagnosis.py --quick"),
