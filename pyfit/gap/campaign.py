@@ -256,18 +256,16 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
         where = f"Dask scheduler {scheduler}"
     run_by = {"wall_s": time.perf_counter() - t0, "resumed": resumed, "where": where}
     before = out / "summary.json"
-    if 0 < resumed < n and before.is_file():
+    earlier = json.loads(before.read_text()) if resumed and before.is_file() else None
+    if earlier and resumed == n:  # every case stored: summarised again, with the wall time of their run
+        run_by = {k: earlier[k] for k in ("wall_s", "resumed", "where", "earlier_wall_s") if k in earlier}
+    elif earlier and earlier.get("cases") == n:
         # the resumed cases were diagnosed by the run that wrote the summary before (and those it read by the ones
         # before it): with this run's, a full run's wall time at most
-        earlier = json.loads(before.read_text())
-        if earlier.get("cases") == n:
-            run_by["earlier_wall_s"] = earlier["wall_s"] + earlier.get("earlier_wall_s", 0.0)
+        run_by["earlier_wall_s"] = earlier["wall_s"] + earlier.get("earlier_wall_s", 0.0)
     # every report's confidence as stated with the calibration this run reads (an outcome read from an earlier run
     # holds the one that run read)
     outcomes = [{**o, "stated": stated_with(o, stated_from)} for o in outcomes]
-    if resumed == n and before.is_file():  # every case stored: summarised again, with the wall time of their run
-        earlier = json.loads(before.read_text())
-        run_by = {k: earlier[k] for k in ("wall_s", "resumed", "where", "earlier_wall_s") if k in earlier}
     summary = summarise(outcomes)
     summary.update({"cases": n, "seed": seed, "record_s": record_s, **run_by,
                     "command": command(n, seed, model, config),

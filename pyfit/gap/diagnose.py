@@ -66,7 +66,7 @@ class DiagnoseConfig:
 
 
 _SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
-                   bool if f.name == "refit_within_noise" else
+                   bool if isinstance(f.default, bool) else
                    int if f.name in ("nominal_budget", "refit_budget", "upsample", "max_effects", "partners",
                                  "combination_probes", "grid_models")
                    else "number"), False, f.default)
@@ -151,6 +151,11 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
         digest.update(m.path.read_bytes())
         digest.update(m.path.with_suffix(".toml").read_bytes())
     return records, cal, held, digest.hexdigest()[:16], order, aside
+
+
+def _simulated(runner, records, values: dict, system, cfg: DiagnoseConfig) -> dict:
+    """Each of `records` simulated with `values` (record name -> outputs; None where a simulation failed)."""
+    return {r.name: sim.simulate(runner, r, values, cfg.upsample, system.lead_periods) for r in records}
 
 
 def _fit_and_store(job) -> Fit:
@@ -290,7 +295,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     controls = {}  # a combination -> what refitting on alone bought the model it extends (selection.budget_control)
 
     def on_held(values):  # the held-out records simulated with `values`
-        return {r.name: sim.simulate(runner, r, values, cfg.upsample, system.lead_periods) for r in held}
+        return _simulated(runner, held, values, system, cfg)
 
     def simulated(name):
         sims[name] = on_held(fits[name].params)
@@ -483,8 +488,7 @@ def _detection(system, fits: dict, sims: dict, held, gap: dict, scale, runner, c
     after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
     best = min(after, key=after.get)
     absent = {**fits[best].params, **system.effects[best].absent(scale)}
-    linear_only = selection.heldout_nrmse(
-        {r.name: sim.simulate(runner, r, absent, cfg.upsample, system.lead_periods) for r in held}, held)
+    linear_only = selection.heldout_nrmse(_simulated(runner, held, absent, system, cfg), held)
     before = min(gap["overall"], linear_only)
     return {"effect": best, "heldout_after": after[best], "linear_only": linear_only,
             "cut": 1.0 - after[best] / before if before > 0 else 0.0, "min_cut": cfg.min_detect_cut,
@@ -581,8 +585,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
                                 f"{ {n: nominal.params[n] for n in nominal.free} })")
         deflections.append(system.deflection(moved, r))
     scale = system.scale(deflections, cal[0].fs, nominal.params)
-    sims = {"nominal": {r.name: sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods)
-                        for r in records}}
+    sims = {"nominal": _simulated(runner, records, nominal.params, system, cfg)}
     bands = [tuple(b) for b in cfg.bands_hz] if cfg.bands_hz else localise.default_bands(records)
     gap = report.nominal_gap(sims["nominal"], records, held, bands, cfg)
     clock.end("where (nominal gap)")
@@ -619,8 +622,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         for fit in _run_fits(jobs, workers or os.cpu_count() or 1, workers, progress, "refits"):
             fits[fit.effect] = fit
         for name, f in fits.items():  # an effect is judged on the held-out files only
-            sims[name] = {r.name: sim.simulate(runner, r, f.params, cfg.upsample, system.lead_periods)
-                          for r in held}
+            sims[name] = _simulated(runner, held, f.params, system, cfg)
         clock.end("refits with each effect")
         if not gap["significant"]:
             gap["detection"] = _detection(system, fits, sims, held, gap, scale, runner, cfg)
@@ -665,8 +667,7 @@ def misfit_at(model: str, data_dir, params: dict, cfg: DiagnoseConfig | None = N
                              load_nominal(nominal) if isinstance(nominal, (str, pathlib.Path)) else nominal)
         _, cal, held, *_ = _load(data_dir, system, cfg, runner)
         values = {**system.nominal_fixed, **params}
-        return SplitMisfit(*(selection.heldout_nrmse(
-            {r.name: sim.simulate(runner, r, values, cfg.upsample, system.lead_periods) for r in files}, files)
-            for files in (held, cal)))
+        return SplitMisfit(*(selection.heldout_nrmse(_simulated(runner, files, values, system, cfg), files)
+                             for files in (held, cal)))
     finally:
         runner.close()
