@@ -4,7 +4,7 @@ import json
 
 import numpy as np
 
-from pyfit.gap import confidence, datasets
+from pyfit.gap import datasets
 from pyfit.gap import diagnose as dg
 
 # CI budgets: fewer evaluations per fit, and the forward selection from the best single effect only with three
@@ -49,8 +49,9 @@ def found_where_it_acts(root, fmu_dir, effect, measured):
 
 
 def strength_recovered(root, fmu_dir, effect, strength, measured):
-    """The chosen effect removes at least 95 % of the held-out gap, the report states the confidence the
-    package's campaign calibration gives such a report, and the refit's strength is within 2 % of the truth's
+    """The chosen effect removes at least 95 % of the held-out gap, the report states no confidence (no campaign
+    was run with the CI budgets: a calibration is of the settings it was made with), and the refit's strength is
+    within 2 % of the truth's
     (k3 = 3e8 N/m^3, F_c = 1 N, c2 = 10 N·s²/m²; the friction's smoothing velocity v_s is fitted with F_c,
     log-scaled, but barely shapes these displacement records)."""
     truth = json.loads((case(root, effect) / "truth.json").read_text())["params"][strength]
@@ -58,8 +59,6 @@ def strength_recovered(root, fmu_dir, effect, strength, measured):
     rep = json.loads((out / "report.json").read_text())
     best = rep["ranking"][0]
     assert best["effect"] == effect and best["shrink_pct"] >= 95.0  # measured 100 % on each
-    conf = rep["confidence"]
-    assert conf["of"] > 0 and "≥ 95" in conf["alike"] and conf["low"] <= conf["rate"] <= conf["high"]
-    assert confidence.Confidence(**conf).sentence() in (out / "report.md").read_text()
+    assert rep["confidence"] is None and "Confidence" not in (out / "report.md").read_text()
     measured(f"SDOF gap diagnosis, {effect} withheld (CI budgets): |fitted {strength} / truth − 1|",
              abs(best["params"][strength] / truth - 1), 0.02)

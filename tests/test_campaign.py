@@ -1,6 +1,7 @@
 """The validation campaign (pyfit.gap.campaign): its draw and its summary; the short campaign itself (20 random
 cases written by the CasADi reference and diagnosed on a Dask LocalCluster) is in the slow tier."""
 import json
+import pathlib
 import time
 
 import numpy as np
@@ -8,6 +9,8 @@ import pytest
 
 from pyfit.gap import campaign, confidence, datasets
 from pyfit.gap.systems import DAMPER_LOOP_STARTS, SDOF_EFFECTS, SDOF_LOOP_STARTS, Scale
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 
 def test_the_draw_is_reproducible_and_spans_nulls_singles_and_pairs():
@@ -46,12 +49,17 @@ def test_drawn_dampers_span_the_catalogue_and_their_band_holds_two_resonances():
                          for lp in loops)
 
 
-def test_a_campaign_read_back_states_every_report_with_the_calibration_it_reads(tmp_path):
+@pytest.mark.parametrize("config", [None, "diagnose_nominal_threshold.toml"])
+def test_a_campaign_read_back_states_every_report_with_the_calibration_it_reads(tmp_path, config):
     """Outcomes stored by an earlier run hold the confidence that run's calibration gave; the summary states every
-    report's with the calibration the package carries now, as a report diagnosed in this run states it."""
+    report's with the calibration the package carries now for the campaign's settings (the defaults; the
+    nominal's threshold alone, a calibration of its own), as a report diagnosed in this run states it."""
     from dataclasses import asdict
 
-    package = confidence.load()
+    from pyfit.gap.diagnose import DiagnoseConfig, load_config
+
+    path = None if config is None else str(ROOT / "configs" / config)
+    package = confidence.load(confidence.settings_of(asdict(load_config(path) if path else DiagnoseConfig())))
     for c in campaign.draw(3, seed=0):
         named = c.withheld
         (tmp_path / f"case{c.index:04d}").mkdir()
@@ -59,12 +67,13 @@ def test_a_campaign_read_back_states_every_report_with_the_calibration_it_reads(
             {"named": named, "withheld": c.withheld, "enr": 20.0, "top_shrink_pct": None if named == "none" else 99.0,
              "verdict": "no significant gap" if named == "none" else f"gap explained by {named}", "stated": 0.01,
              "data_s": 1.0, "diagnose_s": 2.0, "case": asdict(c)}))
-    campaign.run(3, tmp_path, seed=0, workers=1, progress=False)
+    campaign.run(3, tmp_path, seed=0, workers=1, progress=False, config=path)
     stored = json.loads((tmp_path / "summary.json").read_text())
-    assert stored["resumed"] == 3
+    assert stored["resumed"] == 3 and stored["stated_from"]["source"] == package["source"]
     for o in stored["outcomes"]:
         chosen = None if o["named"] == "none" else o["named"]
         assert o["stated"] == confidence.stated(o["verdict"], chosen, o["top_shrink_pct"], package)["rate"] != 0.01
+
 
 def test_calibrating_on_damper_cases_is_refused(tmp_path):
     with pytest.raises(ValueError, match="calibration is of sdof cases"):

@@ -65,8 +65,26 @@ def test_the_check_compares_stated_confidence_with_what_happened():
     assert rows[1]["right"] == 2 and rows[0]["mean_stated"] is None
 
 
-def test_the_package_carries_a_calibration_from_a_campaign():
-    cal = confidence.load()
+def test_a_calibration_is_read_for_the_settings_it_was_made_with_only(tmp_path):
+    path = tmp_path / "calibration.json"
+    default, other = {"refit_within_noise": False, "min_gap": 0.005}, {"refit_within_noise": True, "min_gap": 0.005}
+    confidence.write(confidence.calibration_of(OUTCOMES, "default settings", 4, default), path)
+    confidence.write(confidence.calibration_of(OUTCOMES[:3], "other settings", 4, other), path)
+    confidence.write(confidence.calibration_of(OUTCOMES[:5], "other settings, again", 4, other), path)  # replaces
+    assert confidence.load(default, path)["cases"] == 17
+    assert (confidence.load(other, path)["source"], confidence.load(other, path)["cases"]) == ("other settings, again", 5)
+    assert confidence.load({"refit_within_noise": True, "min_gap": 0.01}, path) is None
+    assert confidence.load({"refit_within_noise": True}, path) is None  # a setting it was not made with
+    # where the files are (which are calibrated on, the bands) is no setting of the rule
+    assert confidence.settings_of({"min_gap": 0.005, "calibration": ["a"], "bands_hz": None}) == {"min_gap": 0.005}
+
+
+def test_the_package_carries_a_calibration_of_the_default_settings_from_a_campaign():
+    from dataclasses import asdict
+
+    from pyfit.gap.diagnose import DiagnoseConfig
+
+    cal = confidence.load(confidence.settings_of(asdict(DiagnoseConfig())))
     assert cal is not None and cal["source"].startswith("stockbridge diagnose --campaign ")
     assert sum(r["named"] for r in cal["by_shrink"]) + cal["no_gap"]["verdicts"] <= cal["cases"]
     assert np.all([0 <= r["right"] <= r["named"] for r in cal["by_shrink"]])

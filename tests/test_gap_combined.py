@@ -2,7 +2,6 @@
 do not hold: truths drawn at random across the family (a generator independent of the FMUs: the CasADi
 reference integrated by CVODES), never at a start value of the candidate. Slow: `pytest -m slow`."""
 import json
-import pathlib
 
 import numpy as np
 import pytest
@@ -12,7 +11,6 @@ from pyfit.gap import diagnose as dg
 from pyfit.gap.systems import DAMPER_EFFECTS, SDOF_EFFECTS, Scale
 
 pytestmark = pytest.mark.slow
-ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 SEED = 20261125  # the truths of this file: each test draws its own from this seed, whatever ran before it
 
@@ -162,14 +160,13 @@ def test_a_weak_loop_beside_a_strong_cubic_spring_is_named_as_both(tmp_path, fmu
 
 
 def _campaign_case_named(tmp_path, fmu_dir, seed: int, index: int, withheld: str, excitation: str,
-                         model: str = "sdof", cfg: dg.DiagnoseConfig | None = None):
+                         model: str = "sdof"):
     """Case `index` of the `model` campaign's draw with `seed` (its withheld effects and excitation checked),
-    written and diagnosed as the campaign does (with `cfg`: default settings); asserts it is named right; returns
-    the case and the report's best model."""
+    written and diagnosed as the campaign does (default settings); asserts it is named right; returns the case and
+    the report's best model."""
     case = campaign.draw(index + 1, seed=seed, model=model)[index]
     assert case.withheld == withheld and case.excitation == excitation
-    outcome = campaign.run_case(campaign.CaseJob(case, str(tmp_path), fmu_dir, campaign.RECORD_S,
-                                                 cfg or dg.DiagnoseConfig()))
+    outcome = campaign.run_case(campaign.CaseJob(case, str(tmp_path), fmu_dir, campaign.RECORD_S))
     assert outcome["named"] == withheld, outcome["verdict"]
     report = tmp_path / f"case{index:04d}" / "diagnosis" / "report.json"
     return case, json.loads(report.read_text())["ranking"][0]
@@ -276,11 +273,10 @@ def test_a_weak_sharp_loop_softening_on_both_branches_is_named(tmp_path, fmu_dir
 
 def test_an_effect_under_the_noise_threshold_is_told_from_noise_by_its_refit(tmp_path, fmu_dir, measured):
     """A weak quadratic damping under a sweep recorded as displacement (a case of the check campaign's draw,
-    CasADi reference): the nominal's held-out misfit is within the noise threshold, but with refit_within_noise
-    the damping's refit removes part of it on the held-out files, where a refit of noise alone carries nothing
-    over; the damping is named and c2 recovered."""
-    case, best = _campaign_case_named(tmp_path, fmu_dir, 19, 18, "quadratic_damping", "sweep",
-                                      cfg=dg.load_config(ROOT / "configs" / "diagnose_within_noise.toml"))
+    CasADi reference): the nominal's held-out misfit is within the noise threshold, but the damping's
+    refit (refit_within_noise, the default) removes part of it on the held-out files, where a refit
+    of noise alone carries nothing over; the damping is named and c2 recovered."""
+    case, best = _campaign_case_named(tmp_path, fmu_dir, 19, 18, "quadratic_damping", "sweep")
     gap = json.loads((tmp_path / "case0018" / "diagnosis" / "report.json").read_text())["gap"]
     assert gap["overall"] <= selection.noise_level(gap["noise_floor"], dg.DiagnoseConfig().noise_factor,
                                                    dg.DiagnoseConfig().min_gap)  # under the nominal's own test
@@ -291,11 +287,11 @@ def test_an_effect_under_the_noise_threshold_is_told_from_noise_by_its_refit(tmp
 
 
 def test_noise_alone_refitted_below_the_noise_threshold_is_no_gap(tmp_path, fmu_dir, measured):
-    """A null case of the check campaign's draw (nothing withheld; CasADi reference) with refit_within_noise: every
-    single effect is refitted, and the best of them removes less of the held-out misfit than min_detect_cut (what
-    a refit fits of the calibration files' noise does not carry over to the held-out files): no gap."""
-    _campaign_case_named(tmp_path, fmu_dir, 19, 4, "none", "stepped_sine",
-                         cfg=dg.load_config(ROOT / "configs" / "diagnose_within_noise.toml"))
+    """A null case of the check campaign's draw (nothing withheld; CasADi reference): within the noise threshold
+    every single effect is refitted all the same (refit_within_noise, the default), and the best of them removes
+    less of the held-out misfit than min_detect_cut (what a refit fits of the calibration files' noise does not
+    carry over to the held-out files): no gap."""
+    _campaign_case_named(tmp_path, fmu_dir, 19, 4, "none", "stepped_sine")
     gap = json.loads((tmp_path / "case0004" / "diagnosis" / "report.json").read_text())["gap"]
     assert not gap["detection"]["detected"]
     measured("SDOF null case refitted below the noise threshold: share of the held-out misfit the best refit "

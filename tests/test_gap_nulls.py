@@ -1,13 +1,14 @@
 """Sim-to-real gap diagnosis of SDOF datasets, continued: no false alarm on null datasets (noise seeds 1 and 2
 under -m slow), a skew between the channels named sensor_delay, clear errors on bad input, the linear start
 from the measured FRF of accelerometer records under band-limited noise."""
+import dataclasses
 import shutil
 
 import numpy as np
 import pytest
 
 from gap_cases import CI, case
-from pyfit.gap import confidence, datasets
+from pyfit.gap import datasets
 from pyfit.gap import diagnose as dg
 from pyfit.gap import simulate as sim
 from pyfit.gap.systems import sdof_start
@@ -21,13 +22,13 @@ def data_root(tmp_path_factory):
 
 @pytest.mark.parametrize("seed", [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)])
 def test_null_dataset_gives_no_false_alarm(data_root, fmu_dir, seed, measured):
-    rep = dg.diagnose("sdof", case(data_root, "none", seed), data_root / f"out_none{seed}", CI, fmu_dir,
+    # seed 0 by the nominal's test alone; the slow seeds with the default refits within the noise (about a minute of
+    # CPU on each of these nulls): what the best refit removes of the held-out misfit stays below min_detect_cut
+    cfg = dataclasses.replace(CI, refit_within_noise=seed > 0)
+    rep = dg.diagnose("sdof", case(data_root, "none", seed), data_root / f"out_none{seed}", cfg, fmu_dir,
                       workers=2, progress=False)
     assert rep["verdict"] == "no significant gap" and rep["chosen_effect"] is None
-    # the confidence the package's campaign calibration gives this verdict, stated in the report
-    conf = rep["confidence"]
-    assert conf["of"] > 0 and "no significant gap" in conf["alike"] and conf["low"] <= conf["rate"] <= conf["high"]
-    assert confidence.Confidence(**conf).sentence() in (data_root / f"out_none{seed}" / "report.md").read_text()
+    assert rep["gap"]["detection"]["cut"] < cfg.min_detect_cut if seed else not rep["ranking"]
     # the nominal fit sits on the noise floor the data give (5e-6 m noise, about 0.4 % of the output RMS)
     measured(f"SDOF gap diagnosis, null dataset seed {seed} ('no significant gap'): |held-out gap / noise floor − 1|",
              abs(rep["gap"]["overall"] / rep["gap"]["noise_floor"] - 1), 0.1)

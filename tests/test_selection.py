@@ -120,7 +120,7 @@ def test_a_model_that_explains_the_data_with_nothing_a_candidate_explains_left_i
 
 def test_a_refit_finds_a_gap_below_the_noise_threshold_only_when_it_carries_over_to_the_held_out_files():
     """The held-out misfits of two check-campaign cases under the nominal's noise threshold, refitted with every
-    single effect (configs/diagnose_within_noise.toml): a weak quadratic damping's refit takes 0.00889 to 0.00554
+    single effect (refit_within_noise): a weak quadratic damping's refit takes 0.00889 to 0.00554
     (its linear values alone 0.0264), a null case's best refit 0.005084 to 0.005083 (its linear values alone
     0.005082: what it removes is the linear re-adjustment's, not the effect's)."""
     cut = DiagnoseConfig().min_detect_cut

@@ -228,17 +228,17 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     a Dask LocalCluster of `workers` single-threaded processes. Writes OUT/summary.md and OUT/summary.json (a
     campaign whose every case is stored is summarised again, with the wall time of the run that diagnosed them);
     with `calibrate` (SDOF cases only: the confidence is stated for SDOF diagnoses), its hit rates become the
-    package's confidence calibration (pyfit.gap.confidence); `config`: a TOML file of diagnosis settings
-    (pyfit.gap.diagnose.load_config; default: the defaults, which the calibration is of)."""
-    if calibrate and config:
-        raise ValueError("--calibrate: the package's calibration is of the default diagnosis settings; drop --config")
+    package's confidence calibration of its settings (pyfit.gap.confidence), and the summary states every report's
+    confidence with it (in-sample); `config`: a TOML file of diagnosis settings (pyfit.gap.diagnose.load_config;
+    default: the defaults)."""
     if calibrate and model != confidence.FAMILY:
         raise ValueError(f"--calibrate: the package's calibration is of {confidence.FAMILY} cases; the campaign "
                          f"is of {model}")
-    stated_from = confidence.load() if model == confidence.FAMILY else None
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     cfg = load_config(config) if config else DiagnoseConfig()
+    settings = confidence.settings_of(asdict(cfg))
+    stated_from = confidence.load(settings) if model == confidence.FAMILY else None
     jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg) for c in draw(n, seed, model)]
     # cases an earlier run finished (interrupted, or a rerun of only some cases): read, not diagnosed again, so this
     # run's wall time does not cover them
@@ -263,16 +263,17 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
         # the resumed cases were diagnosed by the run that wrote the summary before (and those it read by the ones
         # before it): with this run's, a full run's wall time at most
         run_by["earlier_wall_s"] = earlier["wall_s"] + earlier.get("earlier_wall_s", 0.0)
-    # every report's confidence as stated with the calibration this run reads (an outcome read from an earlier run
-    # holds the one that run read)
+    if calibrate:
+        stated_from = confidence.calibration_of(outcomes, command(n, seed, model, config), seed, settings)
+        confidence.write(stated_from)
+    # every report's confidence as stated with the calibration this run reads or writes (an outcome read from an
+    # earlier run holds the one that run read)
     outcomes = [{**o, "stated": stated_with(o, stated_from)} for o in outcomes]
     summary = summarise(outcomes)
     summary.update({"cases": n, "seed": seed, "record_s": record_s, **run_by,
                     "command": command(n, seed, model, config),
                     "model": model,
                     "stated_from": {k: stated_from[k] for k in ("source", "seed", "cases")} if stated_from else None})
-    if calibrate:
-        confidence.write(confidence.calibration_of(outcomes, command(n, seed, model), seed))
     (out / "summary.json").write_text(json.dumps({**summary, "outcomes": outcomes}, indent=1, default=float))
     (out / "summary.md").write_text(markdown(summary))
     return summary

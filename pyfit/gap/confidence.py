@@ -4,9 +4,12 @@ The campaign counts, per bin of the named model's held-out shrink, how many repo
 of those were right; and how many 'no significant gap' verdicts had nothing withheld. A single report states the
 hit rate of its bin as the centre of the Wilson 95 % interval of that count, with the interval (few cases give
 a wide interval, and the report says so; the centre keeps a bin of one or two reports from stating 0 or 100 %).
-The package carries the calibration of one campaign (calibration.json beside this module, written by
-`stockbridge diagnose --campaign N --calibrate`); a campaign with other cases checks how well the stated
-confidence matches what happens.
+A hit rate is a property of the decision rule as much as of the data: the package carries one calibration per
+set of diagnosis settings a campaign was run with (calibration.json beside this module, written by
+`stockbridge diagnose --campaign N [--config FILE] --calibrate`), and a report states the confidence of the one
+whose settings equal its own (settings_of: every setting but the ones that only say where the data are), none
+when no campaign was run with them. A campaign with other cases checks how well the stated confidence matches
+what happens.
 """
 from __future__ import annotations
 
@@ -21,6 +24,8 @@ CALIBRATION = pathlib.Path(__file__).with_name("calibration.json")
 FAMILY = "sdof"  # the system the calibration's campaign draws: a diagnosis of another states no confidence
 SHRINK_BINS = (-np.inf, 50.0, 80.0, 95.0, np.inf)  # the named model's held-out shrink [%]
 STATED_BINS = (0.0, 0.5, 0.8, 0.95, 1.0 + 1e-9)  # stated confidence, for the check against the hit rate
+# diagnosis settings that say which files are which and what is compared, not how a verdict is reached
+LAYOUT_SETTINGS = ("calibration", "bands_hz", "transient_s")
 
 
 @dataclass(frozen=True)
@@ -75,8 +80,15 @@ def shrink_label(k: int) -> str:
     return range_label(SHRINK_BINS[k], SHRINK_BINS[k + 1])
 
 
-def calibration_of(outcomes: list[dict], source: str, seed: int) -> dict:
-    """The calibration table of a campaign's outcomes (each: named, withheld, verdict, top_shrink_pct)."""
+def settings_of(config: dict) -> dict:
+    """The settings a calibration is of: a diagnosis's settings (dataclasses.asdict of its DiagnoseConfig) but
+    the LAYOUT_SETTINGS."""
+    return {k: v for k, v in config.items() if k not in LAYOUT_SETTINGS}
+
+
+def calibration_of(outcomes: list[dict], source: str, seed: int, settings: dict | None = None) -> dict:
+    """The calibration table of a campaign's outcomes (each: named, withheld, verdict, top_shrink_pct), run with
+    `settings` (settings_of)."""
     named = [o for o in outcomes if o["named"] not in ("none", "error")]
     by_shrink = []
     for k in range(len(SHRINK_BINS) - 1):
@@ -84,19 +96,26 @@ def calibration_of(outcomes: list[dict], source: str, seed: int) -> dict:
         by_shrink.append({"shrink_pct": [SHRINK_BINS[k], SHRINK_BINS[k + 1]], "named": len(inside),
                           "right": sum(o["named"] == o["withheld"] for o in inside)})
     quiet = [o for o in outcomes if o["verdict"] == "no significant gap"]
-    return {"source": source, "seed": seed, "cases": len(outcomes), "by_shrink": by_shrink,
+    return {"source": source, "seed": seed, "cases": len(outcomes), "settings": settings or {},
+            "by_shrink": by_shrink,
             "no_gap": {"verdicts": len(quiet), "right": sum(o["withheld"] == "none" for o in quiet)}}
 
 
+def _stored(path: pathlib.Path) -> list[dict]:
+    return json.loads(path.read_text())["calibrations"] if path.is_file() else []
+
+
 def write(calibration: dict, path: pathlib.Path = CALIBRATION) -> pathlib.Path:
-    """Store a calibration (the package's own by default)."""
-    path.write_text(json.dumps(calibration, indent=1, default=float) + "\n")
+    """Store a calibration (in the package's file by default), in place of one with the same settings."""
+    kept = [c for c in _stored(path) if c["settings"] != calibration["settings"]]
+    path.write_text(json.dumps({"calibrations": kept + [calibration]}, indent=1, default=float) + "\n")
     return path
 
 
-def load(path: pathlib.Path = CALIBRATION) -> dict | None:
-    """The stored calibration, None when there is none."""
-    return json.loads(path.read_text()) if path.is_file() else None
+def load(settings: dict, path: pathlib.Path = CALIBRATION) -> dict | None:
+    """The stored calibration of these settings (settings_of), None when no campaign was run with them (a setting
+    added since a calibration was made counts as another setting)."""
+    return next((c for c in _stored(path) if c["settings"] == settings), None)
 
 
 def stated(verdict: str, chosen: str | None, shrink_pct: float | None, calibration: dict | None) -> dict | None:

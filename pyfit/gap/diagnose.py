@@ -58,8 +58,9 @@ class DiagnoseConfig:
     # candidate's sensitivity explains this share of its calibration residual (the screening at that model)
     grid_models: int = 3  # when no model meets the absolute criterion: the best ones by held-out misfit, each
     # refitted from the best point of a grid over its members' strengths (systems.strength_grid)
-    refit_within_noise: bool = False  # refit the single effects also when the nominal's held-out misfit is
-    # within the noise threshold (an effect too weak for the nominal's test told from noise by its refit)
+    refit_within_noise: bool = True  # refit the single effects also when the nominal's held-out misfit is
+    # within the noise threshold (an effect too weak for the nominal's test told from noise by its refit; false:
+    # the nominal's test alone decides, and a dataset without a gap costs no refits)
     min_detect_cut: float = 0.05  # with refit_within_noise: the gap counts when a single effect's refit removes
     # this share of the held-out misfit (selection.detected_by_refit; against the nominal's and against the refit's
     # own linear values with the effect at zero)
@@ -636,8 +637,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     result["level_order"] = level_order
     result["set_aside"] = {name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in aside.items()}
     top = result["ranking"][0]["shrink_pct"] if result["ranking"] else None
-    result["confidence"] = (confidence.stated(result["verdict"], result["chosen_effect"], top, confidence.load())
-                            if model == confidence.FAMILY else None)
+    calibration = confidence.load(confidence.settings_of(asdict(cfg))) if model == confidence.FAMILY else None
+    result["confidence"] = confidence.stated(result["verdict"], result["chosen_effect"], top, calibration)
     result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample, system.lead_periods)
     runner.close()
     clock.end("verdict")

@@ -24,13 +24,14 @@ RESULTS = {
     "docs/results/quickstart.md": ("results/quickstart/summary.md",
                                    "stockbridge fit --repeats 2 --out results/quickstart"),
     "docs/results/diagnose_cases.md": ("results/diagnose_cases/summary.md",
-                                       "stockbridge diagnose --make-datasets results/gap_cases && "
-                                       "stockbridge diagnose --cases results/gap_cases --out "
-                                       "results/diagnose_cases"),
+                                       "stockbridge diagnose --make-datasets results/gap_cases && stockbridge "
+                                       "diagnose --cases results/gap_cases --config "
+                                       "configs/diagnose_nominal_threshold.toml --out results/diagnose_cases"),
     "docs/results/diagnose_cases_damper.md": ("results/diagnose_cases_damper/summary.md",
                                               "stockbridge diagnose --model damper --make-datasets "
-                                              "results/gap_cases_damper --seeds 0 && stockbridge diagnose "
-                                              "--model damper --cases results/gap_cases_damper --out "
+                                              "results/gap_cases_damper --seeds 0 && stockbridge diagnose --model "
+                                              "damper --cases results/gap_cases_damper --config "
+                                              "configs/diagnose_nominal_threshold.toml --out "
                                               "results/diagnose_cases_damper"),
     "docs/results/diagnose_benchmark.md": ("results/diagnose_benchmark/report.md",
                                            "stockbridge diagnose --benchmark --config "
@@ -42,23 +43,27 @@ RESULTS = {
     "docs/results/diagnose_lab.md": ("results/diagnose_lab/summary.md",
                                      "stockbridge diagnose --make-datasets results/lab_cases --excitation sweep "
                                      "--record a --seeds 0 && stockbridge diagnose --cases results/lab_cases "
-                                     "--out results/diagnose_lab"),
+                                     "--config configs/diagnose_nominal_threshold.toml --out results/diagnose_lab"),
     "docs/results/diagnose_lab_damper.md": ("results/diagnose_lab_damper/summary.md",
                                             "stockbridge diagnose --model damper --nominal "
                                             "configs/symmetric_damper.toml --make-datasets results/lab_cases_damper "
                                             "--excitation sweep --motion x --seeds 0 && stockbridge diagnose "
                                             "--model damper --nominal configs/symmetric_damper.toml --cases "
-                                            "results/lab_cases_damper --out results/diagnose_lab_damper"),
+                                            "results/lab_cases_damper --config "
+                                            "configs/diagnose_nominal_threshold.toml --out "
+                                            "results/diagnose_lab_damper"),
     "docs/results/diagnose_lab_design.md": ("results/diagnose_lab_design/summary.md",
                                             "stockbridge diagnose --model damper --make-datasets "
                                             "results/lab_cases_design --excitation sweep --motion x --seeds 0 && "
                                             "stockbridge diagnose --model damper --cases results/lab_cases_design "
-                                            "--out results/diagnose_lab_design"),
+                                            "--config configs/diagnose_nominal_threshold.toml --out "
+                                            "results/diagnose_lab_design"),
     "docs/results/diagnose_lab_design_acc.md": ("results/diagnose_lab_design_acc/summary.md",
                                                 "stockbridge diagnose --model damper --make-datasets "
                                                 "results/lab_cases_design_acc --excitation sweep --record acc_x1 "
-                                                "acc_x2 --motion a --seeds 0 && stockbridge diagnose --model "
-                                                "damper --cases results/lab_cases_design_acc --out "
+                                                "acc_x2 --motion a --seeds 0 && stockbridge diagnose --model damper "
+                                                "--cases results/lab_cases_design_acc --config "
+                                                "configs/diagnose_nominal_threshold.toml --out "
                                                 "results/diagnose_lab_design_acc"),
     "docs/results/diagnose_impedance.md": ("results/diagnose_impedance/summary.md",
                                            "stockbridge diagnose --model damper --make-datasets "
@@ -76,22 +81,9 @@ RESULTS = {
     "docs/results/campaign.md": ("results/campaign/summary.md",
                                  "stockbridge diagnose --campaign 200 --campaign-seed 18 --calibrate "
                                  "--out results/campaign"),
-    "docs/results/campaign_check.md": ("results/campaign_check/summary.md",
-                                       "stockbridge diagnose --campaign 100 --campaign-seed 19 --out "
-                                       "results/campaign_check"),
-    "docs/results/campaign_damper.md": ("results/campaign_damper/summary.md",
-                                        "stockbridge diagnose --campaign 30 --model damper --out "
-                                        "results/campaign_damper"),
-    # the same campaigns with the refits below the noise threshold (each run into a copy of the campaign above
-    # with its 'no significant gap' cases removed, files, fits and outcomes: the only cases the setting changes)
-    "docs/results/campaign_within_noise.md": ("results/campaign_within_noise/summary.md",
-                                              "stockbridge diagnose --campaign 200 --campaign-seed 18 --config "
-                                              "configs/diagnose_within_noise.toml --out "
-                                              "results/campaign_within_noise"),
-    "docs/results/campaign_check_within_noise.md": ("results/campaign_check_within_noise/summary.md",
-                                                    "stockbridge diagnose --campaign 100 --campaign-seed 19 "
-                                                    "--config configs/diagnose_within_noise.toml --out "
-                                                    "results/campaign_check_within_noise"),
+    # the damper campaign with the default settings written out (configs/diagnose_within_noise.toml), run into a
+    # copy of an earlier run's folder with its 'no significant gap' cases removed: the only cases the refits below
+    # the noise threshold change
     "docs/results/campaign_damper_within_noise.md": ("results/campaign_damper_within_noise/summary.md",
                                                      "stockbridge diagnose --campaign 30 --model damper --config "
                                                      "configs/diagnose_within_noise.toml --out "
