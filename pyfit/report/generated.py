@@ -24,9 +24,9 @@ RESULTS = {
     "docs/results/quickstart.md": ("results/quickstart/summary.md",
                                    "stockbridge fit --repeats 2 --out results/quickstart"),
     "docs/results/diagnose_cases.md": ("results/diagnose_cases/summary.md",
-                                       "stockbridge diagnose --make-datasets results/gap_cases && stockbridge "
-                                       "diagnose --cases results/gap_cases --config "
-                                       "configs/diagnose_nominal_threshold.toml --out results/diagnose_cases"),
+                                       "stockbridge diagnose --make-datasets results/gap_cases && "
+                                       "stockbridge diagnose --cases results/gap_cases --out "
+                                       "results/diagnose_cases"),
     "docs/results/diagnose_cases_damper.md": ("results/diagnose_cases_damper/summary.md",
                                               "stockbridge diagnose --model damper --make-datasets "
                                               "results/gap_cases_damper --seeds 0 && stockbridge diagnose --model "
