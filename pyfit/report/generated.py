@@ -43,7 +43,7 @@ RESULTS = {
     "docs/results/diagnose_lab.md": ("results/diagnose_lab/summary.md",
                                      "stockbridge diagnose --make-datasets results/lab_cases --excitation sweep "
                                      "--record a --seeds 0 && stockbridge diagnose --cases results/lab_cases "
-                                     "--config configs/diagnose_nominal_threshold.toml --out results/diagnose_lab"),
+                                     "--out results/diagnose_lab"),
     "docs/results/diagnose_lab_damper.md": ("results/diagnose_lab_damper/summary.md",
                                             "stockbridge diagnose --model damper --nominal "
                                             "configs/symmetric_damper.toml --make-datasets results/lab_cases_damper "
