@@ -81,6 +81,9 @@ RESULTS = {
     "docs/results/campaign.md": ("results/campaign/summary.md",
                                  "stockbridge diagnose --campaign 200 --campaign-seed 18 --calibrate "
                                  "--out results/campaign"),
+    "docs/results/campaign_check.md": ("results/campaign_check/summary.md",
+                                       "stockbridge diagnose --campaign 100 --campaign-seed 19 --out "
+                                       "results/campaign_check"),
     # the damper campaign with the default settings written out (configs/diagnose_within_noise.toml), run into a
     # copy of an earlier run's folder with its 'no significant gap' cases removed: the only cases the refits below
     # the noise threshold change
