@@ -1,7 +1,7 @@
 """When no model explains the data, the best ones are refitted from the best point of a grid over their members'
 strengths (systems.strength_grid): a hardening spring with a weak quadratic damper on a sweep, where both set
 the frequency at which the response jumps down and the calibration misfit has a narrow valley in the pair's
-strengths. The truth is case 121 of the campaign's random draw (seed 18: the CasADi reference, lab-style
+strengths (that refit under -m slow). The truth is case 121 of the campaign's random draw (seed 18: the CasADi reference, lab-style
 files), on which the forward selection's joint refit stopped at the spring alone."""
 import dataclasses
 
@@ -31,6 +31,7 @@ def test_the_grid_spans_each_members_strengths_and_holds_the_refit(sdof_system):
     assert min(c for c in c2s if c > 0) == pytest.approx(1e-4 * c2_hi)
 
 
+@pytest.mark.slow  # about 25 s of FMU runs: a nominal fit, a refit and the grid's refit
 def test_a_spring_and_damper_setting_a_sweeps_jump_are_found_from_the_grid(tmp_path, sdof_system,
                                                                           measured):
     runner, system = sdof_system
