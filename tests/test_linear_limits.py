@@ -5,6 +5,7 @@ import pytest
 
 from damper_matrices import clamped_matrices
 from pyfit.analysis.modal import free_decay_modes, state_space_modes
+from pyfit.gap.systems import DAMPER_EFFECTS
 
 DT = 5e-4
 # ERA on a noise-free decay integrated at rtol 1e-11 is exact up to the integrator's error (about 1e-10 of
@@ -61,24 +62,48 @@ def test_damper_reference_matrices_have_the_design_frequencies():
     np.testing.assert_allclose(undamped, [10.1, 17.3, 79.0, 125.0], rtol=0.01)
 
 
-def test_damper_linear_modes_match_independent_matrices(runner, measured):
-    # a smooth 10 ms clamp pulse (exact x, v, a), then the clamp rests and the damper rings down
+def _damper_pulse_modes(runner, params):
+    """ERA modes of the damper FMU (`params` over its defaults) ringing down after a smooth 10 ms clamp pulse
+    (exact x, v, a), the clamp then at rest."""
     T = 0.01
     t = np.arange(0, 1.0 + DT / 2, DT / 4)
     s = np.clip(t / T, 0, 1)
     x = 1e-3 * np.sin(np.pi * s) ** 4
     v = np.gradient(x, t)
     a = np.gradient(v, t)
-    params = {"k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "exc_type": 0}
-    res = runner("StockbridgeDamper").simulate(1.0, DT, ["x1", "x2", "phi1", "phi2"], params,
+    res = runner("StockbridgeDamper").simulate(1.0, DT, ["x1", "x2", "phi1", "phi2"],
+                                               {"k_cs1": 0.0, "k_cs2": 0.0, "exc_type": 0, **params},
                                                inputs={"x_base": x, "v_base": v, "a_base": a}, input_time=t,
                                                tolerance=1e-11)
     assert res.ok
     keep = res.time > 2 * T
-    Y = np.column_stack([res[o][keep] for o in ("x1", "x2", "phi1", "phi2")])
-    est = free_decay_modes(Y, DT, 4)
+    return free_decay_modes(np.column_stack([res[o][keep] for o in ("x1", "x2", "phi1", "phi2")]), DT, 4)
+
+
+def test_damper_linear_modes_match_independent_matrices(runner, measured):
+    est = _damper_pulse_modes(runner, {"k_bw1": 0.0, "k_bw2": 0.0})
     ref = state_space_modes(*clamped_matrices())
     assert len(est) == 4
     measured("damper, nonlinear elements off: damped frequencies by ERA from a clamp-pulse decay vs eigenvalues of "
              "independently assembled matrices, max relative error", max(abs(e.f_d / r.f_d - 1) for e, r in zip(est, ref)),
              ERA_TOL)
+
+
+def test_the_damper_loop_reduced_to_its_linear_part_is_a_spring_on_each_arm(runner, measured):
+    """The diagnosis's linear comparator of a loop (Effect.linear_parts): the loop closed, before and after yield,
+    is a spring of k_bw, or a_bw k_bw, between each mass and the clamp: the independent matrices with it added to
+    the masses' translations (the beam's Rayleigh damping unchanged). A loop drawn at random."""
+    rng = np.random.default_rng(20261202)
+    loop = {"k_bw1": rng.uniform(200, 2000), "k_bw2": rng.uniform(200, 2000), "a_bw": rng.uniform(0.1, 0.9),
+            "beta": rng.uniform(0.5, 3), "gamma": rng.uniform(-1, 1), "nu": rng.uniform(1, 3)}
+    M, C, K = clamped_matrices()
+    worst = 0.0
+    for part in DAMPER_EFFECTS["hysteresis"].linear_parts(loop):
+        closed = {**loop, **part}
+        springs = np.zeros_like(K)
+        springs[0, 0], springs[2, 2] = closed["k_bw1"], closed["k_bw2"]  # x1, x2 among the free DOFs
+        est, ref = _damper_pulse_modes(runner, closed), state_space_modes(M, C, K + springs)
+        assert len(est) == 4
+        worst = max(worst, *(abs(e.f_d / r.f_d - 1) for e, r in zip(est, ref)))
+    measured("damper loop reduced to its linear part (before and after yield, a random loop): damped frequencies "
+             "by ERA vs independent matrices with a spring per arm, max relative error", worst, ERA_TOL)

@@ -63,7 +63,7 @@ class DiagnoseConfig:
     # the nominal's test alone decides, and a dataset without a gap costs no refits)
     min_detect_cut: float = 0.05  # with refit_within_noise: the gap counts when a single effect's refit removes
     # this share of the held-out misfit (selection.detected_by_refit; against the nominal's and against the refit's
-    # own linear values with the effect at zero)
+    # own linear values with the effect at zero or reduced to its linear part)
 
 
 _SPEC = {f.name: ((list if f.name in ("effects", "calibration", "bands_hz") else
@@ -484,12 +484,14 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
 def _detection(system, fits: dict, sims: dict, held, gap: dict, scale, runner, cfg: DiagnoseConfig) -> dict:
     """Whether the single effects' refits find a gap the nominal's held-out misfit left within the noise
     threshold: the refit that leaves the least held-out misfit, against the nominal's and against that refit's
-    own linear values with its effect at zero (what refitting the linear parameters alone buys), by
-    selection.detected_by_refit with `cfg.min_detect_cut`."""
+    own linear values with its effect at zero or reduced to its linear part (Effect.linear_parts: what refitting
+    the linear parameters alone buys, and a linear element where the effect acts), by selection.detected_by_refit
+    with `cfg.min_detect_cut`."""
     after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
     best = min(after, key=after.get)
-    absent = {**fits[best].params, **system.effects[best].absent(scale)}
-    linear_only = selection.heldout_nrmse(_simulated(runner, held, absent, system, cfg), held)
+    effect, refit = system.effects[best], fits[best].params
+    linear_only = min(selection.heldout_nrmse(_simulated(runner, held, {**refit, **values}, system, cfg), held)
+                      for values in [effect.absent(scale), *effect.linear_parts(refit)])
     before = min(gap["overall"], linear_only)
     return {"effect": best, "heldout_after": after[best], "linear_only": linear_only,
             "cut": 1.0 - after[best] / before if before > 0 else 0.0, "min_cut": cfg.min_detect_cut,

@@ -80,6 +80,9 @@ class Effect:
     signal_only: bool = False  # acts on the recorded channels, not in the FMU (pyfit.gap.simulate applies it)
     derived: callable = field(default=lambda s: ())  # Scale -> rules giving fixed values from fitted ones
     basin: callable = None  # start values -> the basin they lie in (the refit descends from each basin's best)
+    # fitted values -> overrides that keep only the effect's linear part (a loop closed to a spring): what a linear
+    # element there buys, where the nominal lacks that freedom ([] where it has it, or the effect has no linear part)
+    linear_parts: callable = field(default=lambda params: [])
 
     @property
     def strengths(self) -> int:
@@ -429,7 +432,11 @@ DAMPER_EFFECTS = {
            Param("nu", shape=True, range=lambda s: (1.0, DAMPER_LOOP_STARTS[0]["nu"], 3.0))),
         fixed=lambda s: {"A": 1.0, "D": s.sigma_y},
         signature="amplitude-dependent stiffness and damping of the cable (hysteresis loops), odd distortion",
-        starts=lambda s: [dict(st) for st in DAMPER_LOOP_STARTS[1:]]),
+        starts=lambda s: [dict(st) for st in DAMPER_LOOP_STARTS[1:]],
+        # the nominal has one EI for both arms: a loop's linear part, a stiffness per arm, is a freedom it lacks (the
+        # SDOF's k holds an SDOF loop's); closed to a spring of its stiffness before and after yield
+        linear_parts=lambda p: [{"a_bw": 1.0}, {"a_bw": 1.0, "k_bw1": p["a_bw"] * p["k_bw1"],
+                                                "k_bw2": p["a_bw"] * p["k_bw2"]}]),
     "cubic_stiffness": Effect(
         "cubic_stiffness", _pair("k_cs1", "k_cs2", _sym(lambda s: 0.3 * s.k / s.sigma_y**2)),
         signature="resonance shifts with amplitude squared, odd distortion", starts=_cubic_starts("k_cs1", "k_cs2")),

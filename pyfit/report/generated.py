@@ -30,8 +30,7 @@ RESULTS = {
     "docs/results/diagnose_cases_damper.md": ("results/diagnose_cases_damper/summary.md",
                                               "stockbridge diagnose --model damper --make-datasets "
                                               "results/gap_cases_damper --seeds 0 && stockbridge diagnose --model "
-                                              "damper --cases results/gap_cases_damper --config "
-                                              "configs/diagnose_nominal_threshold.toml --out "
+                                              "damper --cases results/gap_cases_damper --out "
                                               "results/diagnose_cases_damper"),
     "docs/results/diagnose_benchmark.md": ("results/diagnose_benchmark/report.md",
                                            "stockbridge diagnose --benchmark --config "
@@ -49,21 +48,17 @@ RESULTS = {
                                             "configs/symmetric_damper.toml --make-datasets results/lab_cases_damper "
                                             "--excitation sweep --motion x --seeds 0 && stockbridge diagnose "
                                             "--model damper --nominal configs/symmetric_damper.toml --cases "
-                                            "results/lab_cases_damper --config "
-                                            "configs/diagnose_nominal_threshold.toml --out "
-                                            "results/diagnose_lab_damper"),
+                                            "results/lab_cases_damper --out results/diagnose_lab_damper"),
     "docs/results/diagnose_lab_design.md": ("results/diagnose_lab_design/summary.md",
                                             "stockbridge diagnose --model damper --make-datasets "
                                             "results/lab_cases_design --excitation sweep --motion x --seeds 0 && "
                                             "stockbridge diagnose --model damper --cases results/lab_cases_design "
-                                            "--config configs/diagnose_nominal_threshold.toml --out "
-                                            "results/diagnose_lab_design"),
+                                            "--out results/diagnose_lab_design"),
     "docs/results/diagnose_lab_design_acc.md": ("results/diagnose_lab_design_acc/summary.md",
                                                 "stockbridge diagnose --model damper --make-datasets "
                                                 "results/lab_cases_design_acc --excitation sweep --record acc_x1 "
                                                 "acc_x2 --motion a --seeds 0 && stockbridge diagnose --model damper "
-                                                "--cases results/lab_cases_design_acc --config "
-                                                "configs/diagnose_nominal_threshold.toml --out "
+                                                "--cases results/lab_cases_design_acc --out "
                                                 "results/diagnose_lab_design_acc"),
     "docs/results/diagnose_impedance.md": ("results/diagnose_impedance/summary.md",
                                            "stockbridge diagnose --model damper --make-datasets "
@@ -84,13 +79,9 @@ RESULTS = {
     "docs/results/campaign_check.md": ("results/campaign_check/summary.md",
                                        "stockbridge diagnose --campaign 100 --campaign-seed 19 --out "
                                        "results/campaign_check"),
-    # the damper campaign with the default settings written out (configs/diagnose_within_noise.toml), run into a
-    # copy of an earlier run's folder with its 'no significant gap' cases removed: the only cases the refits below
-    # the noise threshold change
-    "docs/results/campaign_damper_within_noise.md": ("results/campaign_damper_within_noise/summary.md",
-                                                     "stockbridge diagnose --campaign 30 --model damper --config "
-                                                     "configs/diagnose_within_noise.toml --out "
-                                                     "results/campaign_damper_within_noise"),
+    "docs/results/campaign_damper.md": ("results/campaign_damper/summary.md",
+                                        "stockbridge diagnose --campaign 30 --model damper --out "
+                                        "results/campaign_damper"),
     "docs/results/bench_peers_fit.md": ("results/bench/peers_fit.md", "python bench/peers_fit.py --seeds 3"),
     "docs/results/bench_peers_diagnosis.md": ("results/bench/peers_diagnosis_quick.md",
                                               "python bench/peers_diagnosis.py --quick"),
