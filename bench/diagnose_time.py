@@ -6,11 +6,14 @@ The cases are the ones a test bench produces: three levels of 35 s linear sweeps
 the damper with hysteresis and cubic springs withheld together (a pair: the forward selection's joint refits
 run too). Goals: SDOF <= 60 s, a damper case <= 180 s.
 
-    python bench/diagnose_time.py [--only sdof|damper|damper_pair]
+    python bench/diagnose_time.py [--only sdof|damper|damper_pair] [--fits]
 
-With --only, the other cases' lines of the results file an earlier run wrote are kept as they were.
+With --only, the other cases' lines of the results file an earlier run wrote are kept as they were. With --fits,
+each case's fits are printed too, in the order they ended (evaluations, wall time, calibration NRMSE): where a
+stage's time goes.
 """
 import argparse
+import json
 import pathlib
 import tempfile
 import time
@@ -27,10 +30,20 @@ CASES = {"sdof": ("sdof", "hysteresis", LabStyle(excitation="sweep")),
 GOAL_S = {"sdof": 60.0, "damper": 180.0}
 
 
+def print_fits(fits_dir: pathlib.Path) -> None:
+    """Every fit a diagnosis stored, in the order they ended: evaluations, wall time [s], calibration NRMSE."""
+    for path in sorted(fits_dir.glob("*.json"), key=lambda f: f.stat().st_mtime):
+        fit = json.loads(path.read_text()).get("fit", {})
+        if "wall_s" in fit:
+            print(f"  {path.stem:70s} {fit['evaluations']:5d} evaluations {fit['wall_s']:6.1f} s "
+                  f"calibration NRMSE {fit['calibration_nrmse']:.4f}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--only", choices=list(CASES))
     ap.add_argument("--fmus", default=str(ROOT / "fmus"))
+    ap.add_argument("--fits", action="store_true", help="print each case's fits (where a stage's time goes)")
     args = ap.parse_args()
     report = BenchReport("diagnose_time", ROOT)
     earlier = report.path.read_text(encoding="utf-8").splitlines() if args.only and report.path.is_file() else []
@@ -48,6 +61,9 @@ def main():
             t0 = time.perf_counter()
             rep = diagnose(model, data, pathlib.Path(tmp) / "out", fmu_dir=args.fmus, workers=2, progress=False)
             wall = time.perf_counter() - t0
+            if args.fits:
+                print(f"{case}:")
+                print_fits(pathlib.Path(tmp) / "out" / "fits")
         stages = ", ".join(f"{k} {v:.0f} s" for k, v in rep["stage_s"].items())
         report.line(f"{opening}{len(rep['ranking'])} candidates and combinations refitted): {wall:.0f} s "
                     f"({wall / GOAL_S[model]:.2f} x the goal of {GOAL_S[model]:.0f} s; {stages}); "

@@ -490,10 +490,11 @@ def _detection(system, fits: dict, sims: dict, held, gap: dict, scale, runner, c
     after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
     best = min(after, key=after.get)
     effect, refit = system.effects[best], fits[best].params
+    parts = effect.linear_parts(refit)
     linear_only = min(selection.heldout_nrmse(_simulated(runner, held, {**refit, **values}, system, cfg), held)
-                      for values in [effect.absent(scale), *effect.linear_parts(refit)])
+                      for values in [effect.absent(scale), *parts])
     before = min(gap["overall"], linear_only)
-    return {"effect": best, "heldout_after": after[best], "linear_only": linear_only,
+    return {"effect": best, "heldout_after": after[best], "linear_only": linear_only, "reduced": bool(parts),
             "cut": 1.0 - after[best] / before if before > 0 else 0.0, "min_cut": cfg.min_detect_cut,
             "detected": selection.detected_by_refit(before, after[best], cfg.min_detect_cut)}
 

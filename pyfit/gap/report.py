@@ -101,8 +101,8 @@ def _detection_lines(gap: dict, cfg) -> list[str]:
         return []
     threshold = selection.noise_level(gap["noise_floor"], cfg.noise_factor, cfg.min_gap)
     told = (f"the nominal's held-out NRMSE {gap['overall']:.4f} is within the noise threshold {threshold:.4f}; the "
-            f"refit with {d['effect']} leaves {d['heldout_after']:.4f} (its linear values with the effect at zero "
-            f"or reduced to its linear part {d['linear_only']:.4f}): it removes "
+            f"refit with {d['effect']} leaves {d['heldout_after']:.4f} (its linear values with the effect at zero"
+            f"{' or reduced to its linear part' if d['reduced'] else ''} {d['linear_only']:.4f}): it removes "
             + (f"{100 * d['cut']:.1f} % of the held-out misfit" if d["cut"] > 0 else "none of the held-out misfit"))
     if d["detected"]:
         return [told + f", at least {100 * d['min_cut']:.0f} %: a gap below the threshold (a refit of noise alone "
