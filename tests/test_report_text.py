@@ -1,5 +1,7 @@
-"""The diagnosis report's text (pyfit.gap.report): how a candidate's listed starts are written in report.md."""
-from pyfit.gap.report import LISTED_IN_FULL, starts_text
+"""The diagnosis report's text (pyfit.gap.report): how a candidate's listed starts are written in report.md, and
+what a gap no candidate explains is told with."""
+from pyfit.gap.diagnose import DiagnoseConfig
+from pyfit.gap.report import LISTED_IN_FULL, POOR_LINEAR_NRMSE, not_explained_lines, starts_text
 from pyfit.gap.systems import SDOF_EFFECTS, Scale
 
 
@@ -19,3 +21,22 @@ def test_many_starts_are_summarised_by_parameter():
     assert "alpha in {3000, 10000, 30000, 60000}" in text
     assert "gamma from 0.0025 to 1.5 (" in text
     assert text.endswith("(each start in report.json, `listed_starts`)")
+
+
+def _unexplained(best_calibration_nrmse: float, shrinks: dict) -> list[str]:
+    ranking = [{"effect": n, "shrink_pct": v, "heldout_gap_after": 0.5} for n, v in shrinks.items()]
+    gap = {"noise_floor": 0.01, "worst_band_hz": (4.7, 6.1)}
+    return not_explained_lines(ranking[0], ranking, gap, (best_calibration_nrmse, "level1"), 0.05, DiagnoseConfig())
+
+
+def test_a_nominal_that_misfits_every_file_and_refits_that_remove_little_are_said_first():
+    """Both conditions: the linear nominal misfits even its best calibration file beyond POOR_LINEAR_NRMSE and no
+    refit removes the required shrink (DiagnoseConfig.min_shrink_pct): the first line says so, with the numbers,
+    and what to try; either condition alone leaves the usual three lines."""
+    required = DiagnoseConfig().min_shrink_pct
+    lines = _unexplained(0.702, {"sensor_delay": 12.1, "hysteresis": 0.2})
+    assert len(lines) == 4
+    assert "(level1) at NRMSE 0.702" in lines[0] and "more than 12.1 %" in lines[0] and "Record a level" in lines[0]
+    assert lines[1].startswith("best candidate sensor_delay")
+    assert len(_unexplained(POOR_LINEAR_NRMSE * 0.99, {"sensor_delay": 12.1})) == 3
+    assert len(_unexplained(0.702, {"cubic_stiffness": required + 1.0})) == 3

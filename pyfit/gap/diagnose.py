@@ -259,7 +259,10 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     values, and the end is kept only when it still removes `min_excess_cut` of what that refit leaves; an end
     still above the absolute criterion is then refitted on from its own values. A path whose start is a member
     of an earlier path's end that explains the data (and is no possible stand-in: a model with a free-shape
-    member, systems.Effect.free_shape, still above the noise) is not tried. When a path ends at a possible
+    member, systems.Effect.free_shape, still above the noise, unless its loop has no basins and was found beside
+    the lean effect its path began at) is not tried. When the best-scoring single effect is a loop without basins
+    still above the noise that fits the calibration files worse than the effect whose sensitivity explains most
+    of the nominal residual (`screening`), the path from that effect goes first. When a path ends at a possible
     stand-in whose loop has no basins (the damper's: its refit descends from a list of starts), the single effect
     whose sensitivity explains most of the nominal residual (`screening`: the share per effect) starts a path
     too, if none has yet: such a loop can take up a strong spring's refit score where the spring's sensitivity
@@ -454,12 +457,22 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             onward(end, fits[end].params, 2 * cfg.refit_budget, f"{_stem(end)}.polished")
         return end
 
+    def found_beside(end):  # a loop without basins (the damper's) found beside the lean effect its path began at
+        return effects[end].basin is None and not system.effects[(effects[end].members or (end,))[0]].free_shape
+
     ends, starts = [], ranked[:cfg.beam]
     screened = max(ranked, key=lambda n: screening.get(n, 0.0))  # the single effects, by their sensitivity
+    if (stand_in(starts[0]) and effects[starts[0]].basin is None and screened != starts[0]
+            and fits[screened].calibration_nrmse < fits[starts[0]].calibration_nrmse):
+        # a loop without basins leads by its held-out score but fits the calibration files worse than the effect
+        # whose sensitivity explains most of the nominal residual: it may stand in for that effect (a hardening
+        # spring's jump on a held-out sweep costs the spring its score), so the path from that effect goes first
+        starts = [screened] + [n for n in starts if n != screened]
     for start in starts:
-        if any(after[e] <= explained_below and start in (effects[e].members or (e,)) and not stand_in(e)
-               for e in ends):
-            break  # an earlier path's end explains the data and holds this start already
+        if any(after[e] <= explained_below and start in (effects[e].members or (e,))
+               and (not stand_in(e) or found_beside(e)) for e in ends):
+            break  # an earlier path's end explains the data and holds this start already (a loop found beside
+            # a lean effect's refit does not stand in for it: the path from the loop alone is not needed)
         ends.append(polished(grow(start)))
         if stand_in(ends[-1]) and effects[ends[-1]].basin is None and screened not in starts:
             starts.append(screened)  # the effect the loop may stand in for, by its sensitivity

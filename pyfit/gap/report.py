@@ -93,6 +93,38 @@ def best_refit(fits: dict) -> tuple[float, str]:
     return min(((f.calibration_nrmse, name) for name, f in fits.items()), default=(float("inf"), ""))
 
 
+POOR_LINEAR_NRMSE = 0.5  # a linear model at this NRMSE on a file reproduces 3/4 of its signal's variance (R² 0.75)
+
+
+def not_explained_lines(best: dict, ranking: list[dict], gap: dict, best_calibration: tuple[float, str],
+                        explained_below: float, cfg) -> list[str]:
+    """The evidence of a gap no candidate explains: the best candidate against the criterion, each candidate's
+    shrink, where the misfit left is largest and what to try next. When the calibrated nominal misfits even its
+    best calibration file by more than POOR_LINEAR_NRMSE and no refit removes `cfg.min_shrink_pct` of the
+    held-out misfit, that is said first: every refit starts from that nominal and takes its ranges from it (its
+    stiffness, its deflection), so it can stop short of an effect that is there."""
+    lines = [f"best candidate {best['effect']}: held-out NRMSE {best['heldout_gap_after']:.4f}, shrink "
+             f"{best['shrink_pct']:.1f} %; an explanation needs NRMSE <= {explained_below:.4f} (noise "
+             f"floor {gap['noise_floor']:.4f}) and shrink >= {cfg.min_shrink_pct:.0f} %",
+             "held-out shrink by candidate: " + ", ".join(f"{d['effect']} {d['shrink_pct']:.1f} %"
+                                                          for d in ranking[:5]),
+             f"the misfit left is largest in the band {gap['worst_band_hz'][0]:.1f}-"
+             f"{gap['worst_band_hz'][1]:.1f} Hz: an effect outside the candidates acts there (a delay "
+             "between the channels, the messenger's frequency-dependent loss, backlash), or the "
+             "description of the system (--nominal) is off there"]
+    nrmse, name = best_calibration
+    most = max(d["shrink_pct"] for d in ranking)
+    if nrmse > POOR_LINEAR_NRMSE and most < cfg.min_shrink_pct:
+        lines.insert(0, f"the calibrated linear nominal misfits even its best calibration file ({name}) at NRMSE "
+                        f"{nrmse:.3f} (above {POOR_LINEAR_NRMSE}: it reproduces less than 3/4 of the signal's "
+                        f"variance) and no refit removes more than {most:.1f} % of the held-out misfit: the refits "
+                        "start from this nominal and take their ranges from it (its stiffness, its deflection), so "
+                        "they can stop short of an effect that is there: every level recorded is strongly nonlinear. "
+                        "Record a level where the response is closer to linear (a smaller one for a stiffening "
+                        "spring, a larger one for a friction joint that sticks) and diagnose the files with it")
+    return lines
+
+
 def _detection_lines(gap: dict, cfg) -> list[str]:
     """What the single refits said of a nominal misfit within the noise threshold (gap["detection"], set by the
     diagnosis when the nominal's test found no gap)."""
@@ -177,15 +209,7 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
                           f"one) but the model with {refit_name} fits them at {refit_cal:.3f}: the response changes "
                           "strongly with amplitude"]
     if significant and nominal_fits and not chosen and best:
-        evidence = [f"best candidate {best['effect']}: held-out NRMSE {best['heldout_gap_after']:.4f}, shrink "
-                    f"{best['shrink_pct']:.1f} %; an explanation needs NRMSE <= {explained_below:.4f} (noise "
-                    f"floor {floor:.4f}) and shrink >= {cfg.min_shrink_pct:.0f} %",
-                    "held-out shrink by candidate: " + ", ".join(f"{d['effect']} {d['shrink_pct']:.1f} %"
-                                                                 for d in ranking[:5]),
-                    f"the misfit left is largest in the band {gap['worst_band_hz'][0]:.1f}-"
-                    f"{gap['worst_band_hz'][1]:.1f} Hz: an effect outside the candidates acts there (a delay "
-                    "between the channels, the messenger's frequency-dependent loss, backlash), or the "
-                    "description of the system (--nominal) is off there"]
+        evidence = not_explained_lines(best, ranking, gap, (best_cal, best_file), explained_below, cfg)
     if chosen:
         sys_effect = system.effects[chosen]
         ranked_screen = sorted(screening, key=lambda k: -screening[k])
