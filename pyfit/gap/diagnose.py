@@ -457,12 +457,15 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             onward(end, fits[end].params, 2 * cfg.refit_budget, f"{_stem(end)}.polished")
         return end
 
-    def found_beside(end):  # a loop without basins (the damper's) found beside the lean effect its path began at
-        return effects[end].basin is None and not system.effects[(effects[end].members or (end,))[0]].free_shape
+    def basin_free_stand_in(name):  # a possible stand-in whose loop has no basins (the damper's)
+        return stand_in(name) and effects[name].basin is None
+
+    def found_beside(end):  # such a loop, found beside the lean effect its path began at
+        return basin_free_stand_in(end) and not system.effects[(effects[end].members or (end,))[0]].free_shape
 
     ends, starts = [], ranked[:cfg.beam]
     screened = max(ranked, key=lambda n: screening.get(n, 0.0))  # the single effects, by their sensitivity
-    if (stand_in(starts[0]) and effects[starts[0]].basin is None and screened != starts[0]
+    if (basin_free_stand_in(starts[0]) and screened != starts[0]
             and fits[screened].calibration_nrmse < fits[starts[0]].calibration_nrmse):
         # a loop without basins leads by its held-out score but fits the calibration files worse than the effect
         # whose sensitivity explains most of the nominal residual: it may stand in for that effect (a hardening
@@ -474,7 +477,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             break  # an earlier path's end explains the data and holds this start already (a loop found beside
             # a lean effect's refit does not stand in for it: the path from the loop alone is not needed)
         ends.append(polished(grow(start)))
-        if stand_in(ends[-1]) and effects[ends[-1]].basin is None and screened not in starts:
+        if basin_free_stand_in(ends[-1]) and screened not in starts:
             starts.append(screened)  # the effect the loop may stand in for, by its sensitivity
         if not left(ends[-1]) or (ends[-1] in settled and not stand_in(ends[-1])):
             break  # a path that reaches the noise, or explains the data with nothing a candidate explains left

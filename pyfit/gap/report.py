@@ -119,7 +119,7 @@ def not_explained_lines(best: dict, ranking: list[dict], gap: dict, best_calibra
                         f"{nrmse:.3f} (above {POOR_LINEAR_NRMSE}: it reproduces less than 3/4 of the signal's "
                         f"variance) and no refit removes more than {most:.1f} % of the held-out misfit: the refits "
                         "start from this nominal and take their ranges from it (its stiffness, its deflection), so "
-                        "they can stop short of an effect that is there: every level recorded is strongly nonlinear. "
+                        "with every level this far from linear they can stop short of an effect that is there. "
                         "Record a level where the response is closer to linear (a smaller one for a stiffening "
                         "spring, a larger one for a friction joint that sticks) and diagnose the files with it")
     return lines
