@@ -40,6 +40,12 @@ def test_a_declared_candidate_has_its_bounds_and_start_from_the_data_scale(tmp_p
     assert c.fmu is None
 
 
+def test_a_declared_friction_ranges_up_to_the_force_of_a_stuck_joint(tmp_path):
+    text = GOOD.replace('upper = "4 * sigma_y"', 'upper = "2 * stuck_force + k * sigma_y"')
+    (p,) = user_candidates.load(_write(tmp_path, text)).effects["backlash"].params
+    assert p.range(Scale(2e-3, 0.1, 1e5, {}, 3.0)) == pytest.approx((0.0, 1e-3, 6.0 + 200.0), rel=1e-15)
+
+
 @pytest.mark.parametrize("change, where", [
     (("start = \"0.5 * sigma_y\"", "start = \"__import__('os')\""), "candidate[0].parameter[0].start"),
     (("start = \"0.5 * sigma_y\"", "start = \"0.5 * omega\""), "candidate[0].parameter[0].start"),

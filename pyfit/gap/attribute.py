@@ -243,6 +243,7 @@ def pinned(task: FitTask, values: dict, budget: int) -> FitTask:
 
 
 STIFFNESS_SCAN = (0.25, 0.5, 1.0, 2.0, 4.0)  # factors on the nominal stiffness tried before the least squares
+DAMPING_SCAN = (0.1, 0.3, 3.0, 10.0)  # factors on the nominal damping (system.damping together) tried likewise
 STRENGTH_FACTORS = (0.25, 0.5, 1.0)  # factors on the screening's Gauss-Newton effect strength tried likewise
 
 
@@ -261,15 +262,20 @@ def _widened(bounds: dict, other: dict) -> dict:
 def nominal_task(system: System, fmu: str, records: list, budget: int, upsample: int, threads: int = 1) -> FitTask:
     """The nominal (linear) calibration: from the best (time-domain residual) of the system's start (the SDOF:
     the FRF of all files; the damper: the described values), the starts from the data (system.data_starts:
-    each file's FRF; the lowest resonance moved onto each measured peak) and the stiffness scaled by
-    STIFFNESS_SCAN, then least squares (never worse than the best start); `threads` records simulated at
-    once (it runs alone, so it may use every core)."""
+    each file's FRF; the lowest resonance moved onto each measured peak), the stiffness scaled by
+    STIFFNESS_SCAN and, for a family with damping parameters (the damper's Rayleigh coefficients), each of those
+    with the damping scaled by DAMPING_SCAN, then least squares (never worse than the best start); `threads`
+    records simulated at once (it runs alone, so it may use every core)."""
     start = {n: v for n, v in system.start(records).items() if n in system.linear}
     found = system.data_starts(records, lambda p: linear_modes(fmu, p))
     scan = [{system.stiffness: start[system.stiffness] * f} for f in STIFFNESS_SCAN if f != 1.0] \
         if system.stiffness in start else []
     alternatives = tuple(found) + tuple(scan)
     bounds = _covering(system, [start] + [{**start, **a} for a in alternatives])
+    # the start and each stiffness of the scan with its damping scaled by DAMPING_SCAN (within the bounds): where
+    # no resonance peak shows (a joint stuck at the lowest level, an overdamped response) no data start sets it
+    alternatives += tuple({**a, **{n: float(np.clip(start[n] * g, *bounds[n])) for n in system.damping}}
+                          for a in [{}] + scan for g in DAMPING_SCAN) if system.damping else ()
     return FitTask(fmu, tuple(records), dict(system.nominal_fixed), start, bounds, "nominal", 0, budget, upsample,
                    system.lead_periods, alternatives, threads)
 

@@ -604,7 +604,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
             raise DiagnoseError(f"{r.name}: the calibrated nominal model fails on this file (parameters "
                                 f"{ {n: nominal.params[n] for n in nominal.free} })")
         deflections.append(system.deflection(moved, r))
-    scale = system.scale(deflections, cal[0].fs, nominal.params)
+    scale = system.scale(deflections, cal[0].fs, nominal.params, cal)
     sims = {"nominal": _simulated(runner, records, nominal.params, system, cfg)}
     bands = [tuple(b) for b in cfg.bands_hz] if cfg.bands_hz else localise.default_bands(records)
     gap = report.nominal_gap(sims["nominal"], records, held, bands, cfg)

@@ -106,7 +106,8 @@ def _stored(path: pathlib.Path, key: str) -> tuple[dict, int] | None:
 
 def deflection_scale(fmu: str, test: ImpedanceTest, params: dict, settle: float = 4.0) -> Scale:
     """Scale of the effects: RMS over the test points of cable end 1 relative to the clamp [m] and of its rate
-    [m/s] (the calibrated nominal under each clamp sine, after `settle` s), and the arm's tip stiffness."""
+    [m/s] (the calibrated nominal under each clamp sine, after `settle` s), the arm's tip stiffness, and the force
+    a stuck joint transmits (systems.damper_stuck_force: the heavier mass at the clamp's peak acceleration)."""
     specs = [RunSpec(fmu, settle + 2.0 / f, 1.0 / (40 * f), ("x1", "x_clamp"),
                      {**params, "exc_type": 1, "exc_amplitude": float(a), "exc_f_start": float(f), "exc_t_ramp": 1.5})
              for f, row in zip(test.frequencies, test.amplitudes) for a in row]
@@ -119,8 +120,10 @@ def deflection_scale(fmu: str, test: ImpedanceTest, params: dict, settle: float 
         rms.append(float(np.sqrt(np.mean(rel ** 2))))
     omega = 2 * np.pi * np.repeat(test.frequencies, test.amplitudes.shape[1])
     rms = np.array(rms)
+    peak_acc = max(float(np.max((2 * np.pi * f) ** 2 * np.abs(row))) for f, row in zip(test.frequencies,
+                                                                                       test.amplitudes))
     return Scale(float(np.sqrt(np.mean(rms ** 2))), float(np.sqrt(np.mean((omega * rms) ** 2))),
-                 damper_stiffness(params), dict(params))
+                 damper_stiffness(params), dict(params), max(params["m1"], params["m2"]) * peak_acc)
 
 
 def _strength_starts(effect, scale: Scale) -> list[dict]:

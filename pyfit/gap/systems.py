@@ -22,12 +22,15 @@ from pyfit.gap.localise import excited_band
 @dataclass(frozen=True)
 class Scale:
     """Data scale for bounds: element deflection RMS [m], its velocity RMS [m/s], nominal stiffness [N/m],
-    and the nominal model's parameter values (SI) for effects that are deviations from them."""
+    the nominal model's parameter values (SI) for effects that are deviations from them, and the scale of the
+    force [N] a joint transmits when it does not slip (the damper's heavier mass carried at the clamp's peak
+    acceleration, damper_stuck_force; 0 where the family has none)."""
 
     sigma_y: float
     sigma_v: float
     k: float
     nominal: dict = field(default_factory=dict)
+    stuck_force: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -117,12 +120,13 @@ class System:
     start: callable  # records -> start values of `linear`
     data_starts: callable  # (records, modes_of, calibrated=None) -> other starts of `linear` (see make_system)
     bounds: callable  # (start, softened) -> bounds of `linear`
-    scale: callable  # (deflections, fs, nominal params) -> Scale
+    scale: callable  # (deflections, fs, nominal params, calibration records) -> Scale
     effects: dict
     lead_periods: int = 1  # periods simulated before a periodic record (the decay of the slowest mode)
     deflection_outputs: tuple = ()  # FMU outputs that give the nonlinear element's deflection
     motion_inputs: tuple = ()  # displacement, velocity, acceleration inputs that must be consistent (or ())
     deflection: callable = None  # (simulated outputs, record) -> the element's deflection [m]
+    damping: tuple = ()  # the damping parameters among `linear` the nominal's damping scan scales together
 
 
 def combine(effects: list[Effect]) -> Effect:
@@ -232,12 +236,13 @@ def sdof_bounds(start: dict, softened: bool = False) -> dict:
             "k": ((0.05 if softened else 0.5) * start["k"], 2.0 * start["k"])}
 
 
-def deflection_scale(deflections: list[np.ndarray], fs: float, k: float, params: dict) -> Scale:
+def deflection_scale(deflections: list[np.ndarray], fs: float, k: float, params: dict,
+                     stuck_force: float = 0.0) -> Scale:
     """RMS of the nonlinear element's deflection (simulated by the calibrated nominal model from the measured
-    inputs, whatever the sensors were) and of its rate; the stiffness k."""
+    inputs, whatever the sensors were) and of its rate; the stiffness k; the force it transmits when stuck [N]."""
     y = np.concatenate(deflections)
     v = np.concatenate([np.gradient(d) * fs for d in deflections])
-    return Scale(float(np.sqrt(np.mean(y**2))), float(np.sqrt(np.mean(v**2))), k, dict(params))
+    return Scale(float(np.sqrt(np.mean(y**2))), float(np.sqrt(np.mean(v**2))), k, dict(params), stuck_force)
 
 
 def sdof_deflection(sim: dict, rec) -> np.ndarray:
@@ -419,6 +424,22 @@ def damper_stiffness(params: dict) -> float:
     return 3 * params["EI"] / params["L1"] ** 3
 
 
+def damper_stuck_force(records, params: dict) -> float:
+    """The scale [N] of the force an arm's joint transmits when it does not slip: the heavier end mass carried at
+    the clamp's peak acceleration over `records` (a joint that holds moves its arm end with the clamp; the
+    rotation the end mass keeps adds the beam's shear, so a friction of a few times this can still slip at a
+    resonance)."""
+    peak = max(float(np.max(np.abs(r.compared("a_base")))) for r in records)
+    return max(params["m1"], params["m2"]) * peak
+
+
+def _friction_range(s: Scale) -> tuple:
+    """Range of a damper joint's friction force [N]: up to half the spring force at the deflection scale or,
+    when larger, the force the joint transmits stuck (a friction that holds the arms at the lowest level leaves
+    the nominal model almost no deflection to scale it by)."""
+    return (0.0, 0.0, max(0.5 * s.k * s.sigma_y, s.stuck_force))
+
+
 def _pair(name1, name2, rng):
     return (Param(name1, rng), Param(name2, rng))
 
@@ -441,7 +462,7 @@ DAMPER_EFFECTS = {
         "cubic_stiffness", _pair("k_cs1", "k_cs2", _sym(lambda s: 0.3 * s.k / s.sigma_y**2)),
         signature="resonance shifts with amplitude squared, odd distortion", starts=_cubic_starts("k_cs1", "k_cs2")),
     "coulomb_friction": Effect(
-        "coulomb_friction", _pair("F_c1", "F_c2", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y)) + (_stick_velocity,),
+        "coulomb_friction", _pair("F_c1", "F_c2", _friction_range) + (_stick_velocity,),
         signature="damping that falls with amplitude (largest misfit at the lowest level)"),
     "quadratic_damping": Effect(
         "quadratic_damping", _pair("c2_1", "c2_2", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y / s.sigma_v**2)),
@@ -468,6 +489,8 @@ class _Family:
     motion_inputs: tuple
     effects: dict
     lead_periods: int
+    damping: tuple = ()  # linear parameters scaled together by the nominal's damping scan (attribute.DAMPING_SCAN)
+    stuck_force: callable | None = None  # (records, params) -> Scale.stuck_force [N] (None: 0)
 
 
 FAMILY = {
@@ -478,7 +501,8 @@ FAMILY = {
                       {"exc_type": 0, "k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "F_c1": 0.0,
                        "F_c2": 0.0, "c2_1": 0.0, "c2_2": 0.0},
                       ("EI", "alpha_pd", "beta_pd"), "EI", None, damper_modal_starts, damper_bounds, damper_stiffness,
-                      damper_deflection, ("x1",), ("x_base", "v_base", "a_base"), DAMPER_EFFECTS, 2),
+                      damper_deflection, ("x1",), ("x_base", "v_base", "a_base"), DAMPER_EFFECTS, 2,
+                      ("alpha_pd", "beta_pd"), damper_stuck_force),
 }
 
 
@@ -526,9 +550,11 @@ def make_system(name: str, defaults: dict, nominal=None) -> System:
                 out[n] = tuple(sorted((st[n] / 3.0, st[n] * 3.0)))
         return out
 
-    def scale(deflections: list[np.ndarray], fs: float, params: dict) -> Scale:
+    def scale(deflections: list[np.ndarray], fs: float, params: dict, records=()) -> Scale:
         p = {**values, **params}
-        return deflection_scale(deflections, fs, fam.stiffness_of(p), p)
+        stuck = fam.stuck_force(records, p) if fam.stuck_force and records else 0.0
+        return deflection_scale(deflections, fs, fam.stiffness_of(p), p, stuck)
 
     return System(name, fam.fmu, {**fam.switches, **fixed}, linear, fam.stiffness, start, data_starts, bounds,
-                  scale, fam.effects, fam.lead_periods, fam.deflection_outputs, fam.motion_inputs, fam.deflection)
+                  scale, fam.effects, fam.lead_periods, fam.deflection_outputs, fam.motion_inputs, fam.deflection,
+                  tuple(n for n in fam.damping if n in linear))

@@ -10,13 +10,14 @@ parameters with bounds and a start rule. The diagnosis screens, refits and ranks
     [[candidate.parameter]]
     name = "k_m"                        # an FMU parameter; 0 must switch the element off for a strength
     lower = 0.0
-    start = "0.05 * k"                  # a number [SI] or an expression in k [N/m], sigma_y [m], sigma_v [m/s]
+    start = "0.05 * k"                  # a number [SI] or an expression in k, sigma_y, sigma_v, stuck_force
     upper = "2 * k"
     shape = false                       # a shape parameter is not charged in the score (default false)
     log = false                         # fitted on a log scale (positive, spanning decades)
 
-k is the nominal model's stiffness, sigma_y and sigma_v the RMS of the nonlinear element's deflection and
-rate simulated by the calibrated nominal model (pyfit.gap.systems.Scale).
+k is the nominal model's stiffness [N/m], sigma_y and sigma_v the RMS of the nonlinear element's deflection [m]
+and rate [m/s] simulated by the calibrated nominal model, stuck_force the force [N] a damper joint transmits when
+it does not slip (the heavier end mass at the clamp's peak acceleration; 0 for the SDOF) (pyfit.gap.systems.Scale).
 """
 from __future__ import annotations
 
@@ -28,7 +29,7 @@ from dataclasses import dataclass
 from pyfit.gap.systems import Effect, Param, Scale
 from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read_toml
 
-NAMES = ("k", "sigma_y", "sigma_v")
+NAMES = ("k", "sigma_y", "sigma_v", "stuck_force")
 _OPS = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
         ast.Pow: operator.pow}
 
@@ -39,12 +40,12 @@ class CandidateError(ConfigError):
 
 @dataclass(frozen=True)
 class Rule:
-    """A bound or start: a number or an arithmetic expression in k, sigma_y and sigma_v (SI)."""
+    """A bound or start: a number or an arithmetic expression in k, sigma_y, sigma_v and stuck_force (SI)."""
 
     text: str
 
     def __call__(self, scale: Scale) -> float:
-        values = {"k": scale.k, "sigma_y": scale.sigma_y, "sigma_v": scale.sigma_v}
+        values = {"k": scale.k, "sigma_y": scale.sigma_y, "sigma_v": scale.sigma_v, "stuck_force": scale.stuck_force}
 
         def ev(node):
             if isinstance(node, ast.Expression):
