@@ -32,7 +32,8 @@ def _stuck_joint_case(seed: int):
     base, band = damper_geometry(rng)
     t = np.arange(int(RECORD_S * datasets.DAMPER.fs)) / datasets.DAMPER.fs
     noise_seed = int(rng.integers(1 << 30))
-    clamp = motion_with_derivatives(band_noise(*band, datasets.DAMPER.levels[0], noise_seed), t, ("x", "v", "a"))["a"]
+    lowest = band_noise(*band, datasets.DAMPER.levels[0], noise_seed)  # the clamp displacement [m]
+    clamp = motion_with_derivatives(lowest, t, ("x", "v", "a"))["a"]
     a_rms = float(np.sqrt(np.mean(clamp ** 2)))
     friction = {f"F_c{i}": float(rng.uniform(0.5, 1.5) * base[f"m{i}"] * a_rms) for i in (1, 2)}
     style = datasets.LabStyle("noise", DAMPER_OUTPUTS[rng.integers(len(DAMPER_OUTPUTS))],
@@ -40,7 +41,9 @@ def _stuck_joint_case(seed: int):
     return base, band, {**friction, "v_s": 1e-3}, style, noise_seed
 
 
-def _diagnose_stuck_joint(tmp_path, fmu_dir, seed, measured):
+@pytest.mark.parametrize("seed", [pytest.param(s, marks=pytest.mark.slow) if s else s for s in range(3)])
+def test_a_damper_joint_stuck_at_the_lowest_level_is_named_and_its_friction_recovered(tmp_path, fmu_dir, seed,
+                                                                                      measured):
     base, band, truth, style, noise_seed = _stuck_joint_case(seed)
     family = dataclasses.replace(datasets.DAMPER, band_hz=band)
     data = datasets.write_dataset(tmp_path / "data", family, "coulomb_friction", seed=noise_seed, style=style,
@@ -55,12 +58,6 @@ def _diagnose_stuck_joint(tmp_path, fmu_dir, seed, measured):
     error = max(abs(fit[k] / truth[k] - 1.0) for k in ("F_c1", "F_c2"))
     measured(f"stuck damper joint (seed {seed}, {'+'.join(style.outputs)}, clamp {style.motion}): friction "
              "forces recovered, max relative error", error, 0.05)
-
-
-@pytest.mark.parametrize("seed", [pytest.param(s, marks=pytest.mark.slow) if s else s for s in range(3)])
-def test_a_damper_joint_stuck_at_the_lowest_level_is_named_and_its_friction_recovered(tmp_path, fmu_dir, seed,
-                                                                                      measured):
-    _diagnose_stuck_joint(tmp_path, fmu_dir, seed, measured)
 
 
 def test_the_friction_range_reaches_the_force_of_a_stuck_joint():
