@@ -427,7 +427,7 @@ def damper_stiffness(params: dict) -> float:
 def damper_stuck_force(records, params: dict) -> float:
     """The scale [N] of the force an arm's joint transmits when it does not slip: the heavier end mass carried at
     the clamp's peak acceleration over `records` (a joint that holds moves its arm end with the clamp; the
-    rotation the end mass keeps adds the beam's shear, so a friction of a few times this can still slip at a
+    rotation the end mass keeps adds the beam's shear, so a friction above this can still slip near a
     resonance)."""
     peak = max(float(np.max(np.abs(r.compared("a_base")))) for r in records)
     return max(params["m1"], params["m2"]) * peak
