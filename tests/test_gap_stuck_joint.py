@@ -17,7 +17,7 @@ from pyfit.analysis.excitation import band_noise, motion_with_derivatives
 from pyfit.gap import datasets
 from pyfit.gap import diagnose as dg
 from pyfit.gap.campaign import DAMPER_MOTIONS, DAMPER_OUTPUTS, damper_geometry
-from pyfit.gap.systems import DAMPER_EFFECTS, Scale, damper_stuck_force
+from pyfit.gap.systems import DAMPER_EFFECTS, FAMILY, Scale
 from pyfit.io.nominal import NominalModel
 
 RECORD_S = 6.0
@@ -73,7 +73,7 @@ def test_the_friction_range_reaches_the_force_of_a_stuck_joint():
     m1, m2 = rng.uniform(0.5, 4.0, 2)
     records = [Rec(rng.normal(0.0, s, 500)) for s in rng.uniform(0.1, 2.0, 3)]
     peak = max(np.max(np.abs(r.a)) for r in records)
-    stuck = damper_stuck_force(records, {"m1": m1, "m2": m2})
+    stuck = FAMILY["damper"].stuck_force(records, {"m1": m1, "m2": m2})
     assert stuck == pytest.approx(max(m1, m2) * peak, rel=1e-15)
     friction = DAMPER_EFFECTS["coulomb_friction"].params[0]
     # a soft nominal's spring force at its deflection scale (0.5 k σ_y) far below it: the stuck force bounds

@@ -23,7 +23,7 @@ from pyfit.fit.optim.baselines import polish
 from pyfit.gap.attribute import STIFFNESS_SCAN, UnitScaling, effect_start
 from pyfit.gap import selection
 from pyfit.gap.diagnose import DiagnoseConfig, DiagnoseError, fmu_defaults
-from pyfit.gap.systems import Scale, damper_stiffness, make_system
+from pyfit.gap.systems import Scale, damper_stiffness, damper_stuck_force, make_system
 from pyfit.io.impedance import ImpedanceTest, read_impedance
 from pyfit.io.nominal import NominalModel, load_nominal
 from pyfit.report import plots
@@ -123,7 +123,7 @@ def deflection_scale(fmu: str, test: ImpedanceTest, params: dict, settle: float 
     peak_acc = max(float(np.max((2 * np.pi * f) ** 2 * np.abs(row))) for f, row in zip(test.frequencies,
                                                                                        test.amplitudes))
     return Scale(float(np.sqrt(np.mean(rms ** 2))), float(np.sqrt(np.mean((omega * rms) ** 2))),
-                 damper_stiffness(params), dict(params), max(params["m1"], params["m2"]) * peak_acc)
+                 damper_stiffness(params), dict(params), damper_stuck_force(params, peak_acc))
 
 
 def _strength_starts(effect, scale: Scale) -> list[dict]:

@@ -424,13 +424,16 @@ def damper_stiffness(params: dict) -> float:
     return 3 * params["EI"] / params["L1"] ** 3
 
 
-def damper_stuck_force(records, params: dict) -> float:
+def damper_stuck_force(params: dict, peak_acceleration: float) -> float:
     """The scale [N] of the force an arm's joint transmits when it does not slip: the heavier end mass carried at
-    the clamp's peak acceleration over `records` (a joint that holds moves its arm end with the clamp; the
-    rotation the end mass keeps adds the beam's shear, so a friction above this can still slip near a
-    resonance)."""
-    peak = max(float(np.max(np.abs(r.compared("a_base")))) for r in records)
-    return max(params["m1"], params["m2"]) * peak
+    the clamp's peak acceleration [m/s²] (a joint that holds moves its arm end with the clamp; the rotation the
+    end mass keeps adds the beam's shear, so a friction above this can still slip near a resonance)."""
+    return max(params["m1"], params["m2"]) * peak_acceleration
+
+
+def _damper_stuck_force_of(records, params: dict) -> float:
+    """damper_stuck_force at the clamp's peak acceleration over `records`."""
+    return damper_stuck_force(params, max(float(np.max(np.abs(r.compared("a_base")))) for r in records))
 
 
 def _friction_range(s: Scale) -> tuple:
@@ -502,7 +505,7 @@ FAMILY = {
                        "F_c2": 0.0, "c2_1": 0.0, "c2_2": 0.0},
                       ("EI", "alpha_pd", "beta_pd"), "EI", None, damper_modal_starts, damper_bounds, damper_stiffness,
                       damper_deflection, ("x1",), ("x_base", "v_base", "a_base"), DAMPER_EFFECTS, 2,
-                      ("alpha_pd", "beta_pd"), damper_stuck_force),
+                      ("alpha_pd", "beta_pd"), _damper_stuck_force_of),
 }
 
 
