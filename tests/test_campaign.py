@@ -56,10 +56,11 @@ def test_a_campaign_read_back_states_every_report_with_the_calibration_it_reads(
     nominal's threshold alone, a calibration of its own), as a report diagnosed in this run states it."""
     from dataclasses import asdict
 
-    from pyfit.gap.diagnose import DiagnoseConfig, load_config
+    from pyfit.gap.diagnose import DiagnoseConfig, load_config, with_family_drive
 
     path = None if config is None else str(ROOT / "configs" / config)
-    package = confidence.load(confidence.settings_of(asdict(load_config(path) if path else DiagnoseConfig())))
+    package = confidence.load(confidence.settings_of(asdict(with_family_drive(
+        load_config(path) if path else DiagnoseConfig(), "sdof"))))
     for c in campaign.draw(3, seed=0):
         named = c.withheld
         (tmp_path / f"case{c.index:04d}").mkdir()

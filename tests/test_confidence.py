@@ -82,9 +82,9 @@ def test_a_calibration_is_read_for_the_settings_it_was_made_with_only(tmp_path):
 def test_the_package_carries_a_calibration_of_the_default_settings_from_a_campaign():
     from dataclasses import asdict
 
-    from pyfit.gap.diagnose import DiagnoseConfig
+    from pyfit.gap.diagnose import DiagnoseConfig, with_family_drive
 
-    cal = confidence.load(confidence.settings_of(asdict(DiagnoseConfig())))
+    cal = confidence.load(confidence.settings_of(asdict(with_family_drive(DiagnoseConfig(), confidence.FAMILY))))
     assert cal is not None and cal["source"].startswith("stockbridge diagnose --campaign ")
     assert sum(r["named"] for r in cal["by_shrink"]) + cal["no_gap"]["verdicts"] <= cal["cases"]
     assert np.all([0 <= r["right"] <= r["named"] for r in cal["by_shrink"]])

@@ -1,5 +1,6 @@
 """The compiled co-simulation loop (pyfit/runtime/cs_driver.c) gives the same numbers as the Python loop it
-replaces, bit for bit, with linear and with held inputs, and reports a diverging run the same way."""
+replaces, bit for bit, with linear, quadratic (slopes and curvatures sent) and held inputs, and reports a
+diverging run the same way."""
 import numpy as np
 import pytest
 
@@ -26,15 +27,25 @@ def test_compiled_loop_is_available_here():
     assert cs_loop() is not None  # the machine that runs the tests has the C compiler the FMU build needs
 
 
-@pytest.mark.parametrize("hold", [False, True])
-def test_compiled_and_python_loops_agree_bit_for_bit(runner, inputs, monkeypatch, hold):
+@pytest.mark.parametrize("drive", ["lines", "held", "quadratic"])
+def test_compiled_and_python_loops_agree_bit_for_bit(runner, inputs, monkeypatch, drive):
+    from pyfit.analysis.signals import step_quadratics
+
     t, u = inputs
     fmu = runner("SDOFBoucWen")
+    derivatives = None
+    if drive == "quadratic":
+        slope, curvature = step_quadratics(u["u"], 1 / 750.0)
+        derivatives = ({"u": slope}, {"u": curvature})
     compiled, python = _both(fmu, monkeypatch, stop_time=t[-1], output_interval=1 / 750.0, outputs=["y", "z"],
-                             params={"exc_type": 0}, inputs=u, input_time=t, hold_inputs=hold)
+                             params={"exc_type": 0}, inputs=u, input_time=t, hold_inputs=drive == "held",
+                             input_derivatives=derivatives)
     assert compiled.ok and python.ok
     for o in ("y", "z"):
         assert np.array_equal(compiled[o], python[o])
+    if drive == "quadratic":  # the curvatures reach the FMU: another input than the lines between samples
+        lines = fmu.simulate(t[-1], 1 / 750.0, ["y"], {"exc_type": 0}, inputs=u, input_time=t)
+        assert not np.array_equal(lines["y"], compiled["y"])
 
 
 def test_a_diverging_run_fails_the_same_way_in_both_loops(runner, inputs, monkeypatch):

@@ -54,7 +54,7 @@ def test_a_refit_is_the_same_on_one_thread_as_on_two(data_root, sdof_system, mon
     fmu = runner.path
     _, cal, _, _, _, _ = dg._load(case(data_root, "cubic_stiffness"), system, CI, runner)
     assert len(cal) >= 2  # two records to simulate at once
-    one, two = (dg.run_fit(nominal_task(system, fmu, cal, 12, CI.upsample, threads=n)) for n in (1, 2))
+    one, two = (dg.run_fit(nominal_task(system, fmu, cal, 12, system.upsample, threads=n)) for n in (1, 2))
     assert one.params == two.params and one.calibration_nrmse == two.calibration_nrmse
     assert one.evaluations == two.evaluations > 1
 

@@ -103,6 +103,20 @@ def test_the_best_leaner_partner_beside_a_model_is_refitted_jointly_too():
     assert selection.leaner_best([], {}) == []
 
 
+def test_a_rough_loop_behind_a_leaner_partner_beside_a_model_is_refitted_jointly_too():
+    """Calibration misfits of the refits beside the design damper's cubic springs held at their own refit, the
+    diagnosis-time bench's pair (cubic springs with hysteresis withheld): friction (three parameters) leaves
+    0.0908, the true partner, a loop without basins refitted from its one best start (seven), 0.1033, mass
+    offsets (two) 0.1294, a delay (one) 0.1320. The loop is the best richer one among the rough; none beside a
+    loop, and none among partners refitted from each basin."""
+    order = ["cubic + friction", "cubic + loop", "cubic + offsets", "cubic + delay"]
+    sizes = {"cubic + friction": 5, "cubic + loop": 9, "cubic + offsets": 4, "cubic + delay": 3}
+    assert selection.richer_best(order, sizes, {"cubic + loop"}) == ["cubic + loop"]
+    assert selection.richer_best(order[1:], sizes, {"cubic + loop"}) == []
+    assert selection.richer_best(order, sizes, set()) == []
+    assert selection.richer_best([], {}, set()) == []
+
+
 def test_a_model_that_explains_the_data_with_nothing_a_candidate_explains_left_is_not_extended():
     """The screening repeated at the model so far (fractions of its calibration residual), with numbers of the
     diagnoses that found them. Lab sweeps of the family's hysteresis (accelerometer files, floor estimate 0.0036):

@@ -187,6 +187,19 @@ def upsample_spline(u: np.ndarray, factor: int) -> np.ndarray:
     return scipy.interpolate.CubicSpline(t, u, bc_type="natural")(tf)
 
 
+def step_quadratics(u: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Slope and curvature [unit/s, unit/s²] at the start of each step between the samples of u (interval dt
+    [s]) of the quadratic through its cubic spline (natural ends) at the step's start, middle and end: a drive
+    continuous at the samples that follows the spline to fourth order over each step (the last sample: the
+    spline's own derivatives)."""
+    t = np.arange(len(u)) * dt
+    spline = scipy.interpolate.CubicSpline(t, u, bc_type="natural")
+    middle = spline(t[:-1] + 0.5 * dt)
+    curvature = 4.0 * (u[1:] - 2.0 * middle + u[:-1]) / dt ** 2
+    slope = (u[1:] - u[:-1]) / dt - 0.5 * dt * curvature
+    return np.append(slope, spline(t[-1], 1)), np.append(curvature, spline(t[-1], 2))
+
+
 def delayed(y: np.ndarray, fs: float, delay_s: float, periodic: bool = False) -> np.ndarray:
     """y(t - delay_s) on y's own grid [s]: a periodic record by a phase shift of its DFT (exact for whole
     periods), otherwise by its cubic spline, held at the first or last sample beyond the record."""

@@ -29,7 +29,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from pyfit.gap import confidence, datasets
-from pyfit.gap.diagnose import DiagnoseConfig, diagnose, load_config, misfit_at
+from pyfit.gap.diagnose import DiagnoseConfig, diagnose, load_config, misfit_at, with_family_drive
 from pyfit.gap.systems import FAMILY
 from pyfit.io.nominal import NominalModel
 from pyfit.runtime.batch import map_tasks
@@ -236,7 +236,7 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
                          f"is of {model}")
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    cfg = load_config(config) if config else DiagnoseConfig()
+    cfg = with_family_drive(load_config(config) if config else DiagnoseConfig(), model)
     settings = confidence.settings_of(asdict(cfg))
     stated_from = confidence.load(settings) if model == confidence.FAMILY else None
     jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg) for c in draw(n, seed, model)]

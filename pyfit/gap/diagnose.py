@@ -22,7 +22,7 @@ from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read
 from pyfit.gap import confidence, localise, selection, user_candidates
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, nominal_task, pinned, run_fit, screen
-from pyfit.gap.systems import combine, family_fmu, make_system, strength_grid
+from pyfit.gap.systems import FAMILY, combine, family_fmu, make_system, strength_grid
 from pyfit.io.nominal import NominalModel, load_nominal
 
 
@@ -39,7 +39,7 @@ class DiagnoseConfig:
     bands_hz: list | None = None  # [[lo, hi], ...] (default: 8 log-spaced bands over the excited range)
     nominal_budget: int = 60  # FMU evaluations of the nominal calibration
     refit_budget: int = 120  # FMU evaluations per refit with an effect
-    upsample: int = 4  # FMU input grid = sensor rate x upsample
+    upsample: int | None = None  # FMU input grid = sensor rate x upsample (None: the family's, systems.System)
     transient_s: float = 4.0  # a record that does not start at rest: seconds simulated from rest, not compared
     min_gap: float = 0.005  # NRMSE a gap must exceed beyond the noise floor to count
     noise_factor: float = 1.2  # ... and the noise floor times this
@@ -117,7 +117,7 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
         raise DiagnoseError(f"effects: '{unknown[0]}' unknown for {system.name}; allowed: "
                             f"{', '.join(system.effects)}")
     try:
-        records = [sim.record_of(m, system.motion_inputs, cfg.transient_s) for m in ms]
+        records = [sim.record_of(m, system.motion_inputs, cfg.transient_s, system.smooth_inputs) for m in ms]
     except ValueError as exc:
         raise DiagnoseError(str(exc)) from exc
     for m, r in zip(ms, records):
@@ -200,6 +200,11 @@ def _run_fits(jobs, alone: int, workers, progress: bool, desc: str) -> list[Fit]
     jobs = [(dataclasses.replace(task, threads=alone), path, key,
              *(dataclasses.replace(stage, threads=alone) for stage in stages)) for task, path, key, *stages in jobs]
     return map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc=desc)
+
+
+def with_family_drive(cfg: DiagnoseConfig, model: str) -> DiagnoseConfig:
+    """cfg with the drive grid of the family `model` (systems.System.upsample) when it sets none."""
+    return cfg if cfg.upsample is not None else dataclasses.replace(cfg, upsample=FAMILY[model].upsample)
 
 
 def _stem(name: str) -> str:
@@ -378,7 +383,14 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             # a partner with many free parameters (a free-shape loop) absorbs more beside a held model than one
             # with few, whose member held at a refit that made up for it holds it back (a cubic spring stiffened
             # less, a viscous damper raised for a quadratic one): the best of the leaner ones is refitted jointly too
-            joint |= set(selection.leaner_best(order, {n: len(effects[n].params) for n in order}))
+            sizes = {n: len(effects[n].params) for n in order}
+            joint |= set(selection.leaner_best(order, sizes))
+            # and a free-shape loop without basins (the damper's) refitted beside from its one best start only: a
+            # rough estimate, which a leaner partner can lead taking up the loop's dissipation (friction beside a
+            # cubic spring held at its own refit): the best such richer partner is refitted jointly too
+            rough = {n for n in order if (lambda e: e.free_shape and e.basin is None)(
+                system.effects[effects[n].members[-1]])}
+            joint |= set(selection.richer_best(order, sizes, rough))
             for name in set(beside) - joint:  # its fit is the best one beside a path's model so far
                 if fits.get(name) is not beside[name]:
                     fits[name] = beside[name]
@@ -563,6 +575,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     system = make_system(model, fmu_defaults(runner), described)
     if users:
         system = _with_user_candidates(system, users, set(runner.parameter_names()))
+    cfg = with_family_drive(cfg, model)
     records, cal, held, data_key, level_order, aside = _load(data_dir, system, cfg, runner)
     lo, hi = localise.excited_range(records)
     modes = linear_modes(fmu, {**system.nominal_fixed, **system.start(cal)})
@@ -685,6 +698,7 @@ def misfit_at(model: str, data_dir, params: dict, cfg: DiagnoseConfig | None = N
     try:
         system = make_system(model, fmu_defaults(runner),
                              load_nominal(nominal) if isinstance(nominal, (str, pathlib.Path)) else nominal)
+        cfg = with_family_drive(cfg, model)
         _, cal, held, *_ = _load(data_dir, system, cfg, runner)
         values = {**system.nominal_fixed, **params}
         return SplitMisfit(*(selection.heldout_nrmse(_simulated(runner, files, values, system, cfg), files)

@@ -79,6 +79,12 @@ def leaner_best(order: list[str], sizes: dict[str, int]) -> list[str]:
     return [n for n in order if sizes[n] < sizes[order[0]]][:1] if order else []
 
 
+def richer_best(order: list[str], sizes: dict[str, int], among: set[str]) -> list[str]:
+    """Of models listed best first, the best one of `among` with more parameters than the first ([] when none
+    has)."""
+    return [n for n in order if n in among and sizes[n] > sizes[order[0]]][:1] if order else []
+
+
 def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, min_excess_cut: float,
                       control: float = float("inf"), parameters: tuple[int, int] = (0, 0),
                       noise: float = 0.0) -> int:

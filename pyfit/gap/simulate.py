@@ -34,6 +34,7 @@ class Record:
     first: int = 0  # samples of a record that does not start at rest, simulated from rest but not compared
     support: tuple = ()  # (displacement, velocity) inputs of a support motion whose displacement was integrated:
     # the model is simulated from rest relative to that support (simulate)
+    smooth_inputs: bool = False  # the FMU is driven by the inputs' cubic spline (pyfit.runtime.drive)
 
     def compared(self, name: str) -> np.ndarray:
         """An input over the samples that are compared (from `first` on)."""
@@ -59,8 +60,9 @@ def starts_at_rest(m: Measurement, samples: int = 5, fraction: float = 0.05) -> 
     return all(near(v, 0.0) or near(v, np.mean(v)) for c, v in m.values.items() if c in m.outputs)
 
 
-def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> Record:
-    """A Record from a measurement; periodic when its excitation says so (kind multisine, samples_per_period).
+def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0, smooth_inputs: bool = False) -> Record:
+    """A Record from a measurement; periodic when its excitation says so (kind multisine, samples_per_period);
+    with smooth_inputs, the FMU is driven by its inputs' cubic spline (pyfit.runtime.drive).
 
     motion: the model's displacement, velocity and acceleration inputs (e.g. x_base, v_base, a_base): the
     ones not recorded are derived from the recorded one (pyfit.analysis.kinematics, band-limited to the
@@ -97,7 +99,7 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0) -> R
     # a file without a `level` label is named by its file in every table and figure
     support = motion[:2] if motion and motion[0] in derived and not spp else ()  # x integrated
     return Record(m.path.stem, m.level or m.path.stem, float(m.level_value if m.level_value is not None else 0.0),
-                  m.sample_rate_hz, inputs, outputs, spp, weights, derived, first, support)
+                  m.sample_rate_hz, inputs, outputs, spp, weights, derived, first, support, smooth_inputs)
 
 
 def scaled(rec: Record, factor: float) -> Record:
@@ -109,6 +111,10 @@ def scaled(rec: Record, factor: float) -> Record:
 # relative error bound of the FMU's adaptive integrator in a diagnosis run: the outputs stay within 1e-4 of their
 # RMS of a 1e-10 run (test_records.py), a tenth or less of a record's sensor noise
 TOLERANCE = 1e-6
+# the same for a record driven by its inputs' cubic spline: its input error no longer dominates, and the outputs
+# stay within 2e-4 of their RMS of a run at 1e-9 at 16 times the sensor rate (tests/test_spline_drive.py), for
+# less than a 1e-6 run costs on the damper (bench/input_order.py)
+SPLINE_TOLERANCE = 1e-5
 # wall-clock limit of one simulation in a diagnosis [s]: a record simulates in well under a second to a few
 # seconds; a parameter set so stiff that the integrator crawls (a friction smoothed over a tiny velocity beside a
 # hard spring) counts as failed, as a diverging one does, instead of holding a fit for hours
@@ -116,11 +122,14 @@ MAX_WALL_S = 60.0
 
 
 def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, lead_periods: int = 1,
-             tolerance: float = TOLERANCE, outputs=None) -> dict | None:
+             tolerance: float | None = None, outputs=None) -> dict | None:
     """Outputs (model variable -> the compared samples of the record's grid, less their mean; default: the
     record's outputs) for FMU parameters params; None on failure. A periodic record is driven by its period
     averaged over the record (pyfit.runtime.drive): its steady state, one period simulated after lead_periods
-    (at least one) and repeated over the record's periods."""
+    (at least one) and repeated over the record's periods. tolerance: the integrator's (None: SPLINE_TOLERANCE
+    for a record driven by its inputs' spline, else TOLERANCE)."""
+    if tolerance is None:
+        tolerance = SPLINE_TOLERANCE if rec.smooth_inputs else TOLERANCE
     params = dict(params)
     delay = params.pop(SENSOR_DELAY, 0.0)  # not an FMU parameter: a lag of the output channels behind the inputs
     inputs, repeat = rec.inputs, 1
@@ -134,7 +143,7 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
         repeat = rec.n // rec.samples_per_period
         inputs = {k: v.reshape(repeat, rec.samples_per_period).mean(axis=0) for k, v in rec.inputs.items()}
     res = drive(runner, inputs, rec.fs, list(outputs or rec.outputs), params, upsample, rec.samples_per_period,
-                max(lead_periods, 1) if rec.periodic else 0, tolerance, MAX_WALL_S)
+                max(lead_periods, 1) if rec.periodic else 0, tolerance, MAX_WALL_S, rec.smooth_inputs)
     if not res.ok:
         return None
     values = res.values if rigid is None else {k: _moved_back(runner, k, v, *rigid) for k, v in res.values.items()}

@@ -127,6 +127,8 @@ class System:
     motion_inputs: tuple = ()  # displacement, velocity, acceleration inputs that must be consistent (or ())
     deflection: callable = None  # (simulated outputs, record) -> the element's deflection [m]
     damping: tuple = ()  # the damping parameters among `linear` the nominal's damping scan scales together
+    upsample: int = 4  # the FMU's drive grid = the sensor rate x this (DiagnoseConfig.upsample overrides it)
+    smooth_inputs: bool = False  # drive the FMU with the inputs' cubic spline (pyfit.runtime.drive), not lines
 
 
 def combine(effects: list[Effect]) -> Effect:
@@ -494,6 +496,12 @@ class _Family:
     lead_periods: int
     damping: tuple = ()  # linear parameters scaled together by the nominal's damping scan (attribute.DAMPING_SCAN)
     stuck_force: callable | None = None  # (records, params) -> Scale.stuck_force [N] (None: 0)
+    # how the measured inputs drive the FMU: the drive grid's rate over the sensor rate, and whether the FMU
+    # follows their cubic spline (pyfit.runtime.drive) or the lines between the samples: the damper's spline at
+    # twice the sensor rate errs far less than lines at four times, at lower cost (bench/input_order.py); the
+    # SDOF family keeps lines at four times, with which its campaign calibrated the stated confidence
+    upsample: int = 4
+    smooth_inputs: bool = False
 
 
 FAMILY = {
@@ -505,7 +513,7 @@ FAMILY = {
                        "F_c2": 0.0, "c2_1": 0.0, "c2_2": 0.0},
                       ("EI", "alpha_pd", "beta_pd"), "EI", None, damper_modal_starts, damper_bounds, damper_stiffness,
                       damper_deflection, ("x1",), ("x_base", "v_base", "a_base"), DAMPER_EFFECTS, 2,
-                      ("alpha_pd", "beta_pd"), _damper_stuck_force_of),
+                      ("alpha_pd", "beta_pd"), _damper_stuck_force_of, upsample=2, smooth_inputs=True),
 }
 
 
@@ -560,4 +568,4 @@ def make_system(name: str, defaults: dict, nominal=None) -> System:
 
     return System(name, fam.fmu, {**fam.switches, **fixed}, linear, fam.stiffness, start, data_starts, bounds,
                   scale, fam.effects, fam.lead_periods, fam.deflection_outputs, fam.motion_inputs, fam.deflection,
-                  tuple(n for n in fam.damping if n in linear))
+                  tuple(n for n in fam.damping if n in linear), fam.upsample, fam.smooth_inputs)

@@ -72,6 +72,7 @@ RESULTS = {
     "docs/results/bench_fmu_soak.md": ("results/bench/fmu_soak.md", "python bench/fmu_soak.py"),
     "docs/results/bench_eval_speed.md": ("results/bench/eval_speed.md", "python bench/eval_speed.py"),
     "docs/results/bench_diagnose_time.md": ("results/bench/diagnose_time.md", "python bench/diagnose_time.py"),
+    "docs/results/bench_input_order.md": ("results/bench/input_order.md", "python bench/input_order.py"),
     "docs/results/bench_fit_time.md": ("results/bench/fit_time.md", "python bench/fit_time.py"),
     "docs/results/campaign.md": ("results/campaign/summary.md",
                                  "stockbridge diagnose --campaign 200 --campaign-seed 18 --calibrate "

@@ -1,9 +1,9 @@
 /* Co-simulation master loop of FmuRunner, compiled once per machine (pyfit/runtime/native.py).
  *
  * It calls the FMU's own FMI 2.0 functions (passed as pointers, so any FMI 2.0 co-simulation FMU
- * works) for every communication point: set the inputs, read the outputs, send the input slopes,
- * do the step. This is the loop FmuRunner runs in Python when no C compiler is available; here it
- * costs nanoseconds per point instead of microseconds.
+ * works) for every communication point: set the inputs, read the outputs, send the input slopes (and
+ * curvatures), do the step. This is the loop FmuRunner runs in Python when no C compiler is available;
+ * here it costs nanoseconds per point instead of microseconds.
  */
 #define _POSIX_C_SOURCE 199309L
 #include <stddef.h>
@@ -23,21 +23,22 @@ static double seconds(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* Drive n_time communication points. u_at and slope are row-major (n_time x n_in): the input at each
- * point and the slope of the linear input over the step that starts there (slope == NULL: inputs held).
+/* Drive n_time communication points. u_at, slope and curv are row-major (n_time x n_in): the input at each
+ * point, its first time derivative over the step that starts there (slope == NULL: inputs held) and its
+ * second (curv == NULL: none sent; the input is then linear over the step).
  * result is row-major (n_time x n_out). Returns -1 on success, else the index of the point whose call
  * failed; *status gets that call's FMI status, *call which call it was (1 set, 2 get, 3 derivatives,
  * 4 step), or *call = 5 when the loop has run longer than max_wall_s seconds (checked every 16 points;
  * max_wall_s <= 0: no limit). */
 int pyfit_cs_run(fmi2Component comp, SetRealF set_real, GetRealF get_real, SetDerF set_der, DoStepF do_step,
                  int n_time, const double *time, int n_in, const fmi2ValueReference *in_vr, const double *u_at,
-                 const double *slope, int n_out, const fmi2ValueReference *out_vr, double *result,
-                 int *status, int *call, double max_wall_s) {
-  int i, j, order[64];
+                 const double *slope, const double *curv, int n_out, const fmi2ValueReference *out_vr,
+                 double *result, int *status, int *call, double max_wall_s) {
+  int i, j, order[64], order2[64];
   fmi2Status st;
   double t0 = max_wall_s > 0 ? seconds() : 0.0;
   if (n_in > 64) { *status = 3; *call = 1; return 0; }
-  for (j = 0; j < n_in; j++) order[j] = 1;
+  for (j = 0; j < n_in; j++) { order[j] = 1; order2[j] = 2; }
   for (i = 0; i < n_time; i++) {
     if (max_wall_s > 0 && (i & 15) == 0 && seconds() - t0 > max_wall_s) {
       *status = 0; *call = 5; return i;
@@ -50,6 +51,10 @@ int pyfit_cs_run(fmi2Component comp, SetRealF set_real, GetRealF get_real, SetDe
     }
     if (i + 1 == n_time) break;
     if (n_in > 0 && slope && (st = set_der(comp, in_vr, (size_t)n_in, order, slope + (size_t)i * n_in)) > 1) {
+      *status = st; *call = 3; return i;
+    }
+    if (n_in > 0 && slope && curv &&
+        (st = set_der(comp, in_vr, (size_t)n_in, order2, curv + (size_t)i * n_in)) > 1) {
       *status = st; *call = 3; return i;
     }
     if ((st = do_step(comp, time[i], time[i + 1] - time[i], 1)) > 1) {

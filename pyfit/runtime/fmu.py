@@ -211,14 +211,18 @@ class FmuRunner:
                  params: dict | None = None, inputs: dict[str, np.ndarray] | None = None,
                  input_time: np.ndarray | None = None, tolerance: float = 1e-8,
                  start_time: float = 0.0, hold_inputs: bool = False,
-                 max_wall_s: float | None = None) -> SimulationResult:
+                 max_wall_s: float | None = None, input_derivatives: tuple[dict, dict] | None = None
+                 ) -> SimulationResult:
         """Simulate from start_time to stop_time; outputs sampled every output_interval (uniform grid).
 
         inputs: name -> samples at input_time (linear in between, sent with their slopes as input derivatives;
-        hold_inputs=True holds each communication point's value over the step instead, as importers without
-        input derivatives do). A failing or diverging run, or one still running after max_wall_s seconds (None:
-        no limit; a parameter set so stiff that the integrator crawls), returns SimulationResult(ok=False) with
-        the reason; invalid parameter names raise ParameterError.
+        hold_inputs=True holds each communication point's value over the step instead, as importers without input
+        derivatives do). input_derivatives: (slopes, curvatures), name -> each step's input slope and curvature at
+        its start [unit/s, unit/s²] (pyfit.analysis.signals.step_quadratics): each step's input is then the
+        quadratic they give, sent as input derivatives of orders 1 and 2 (co-simulation only, with input_time the
+        communication grid). A failing or diverging run, or one still running after max_wall_s seconds (None: no
+        limit; a parameter set so stiff that the integrator crawls), returns SimulationResult(ok=False) with the
+        reason; invalid parameter names raise ParameterError.
         """
         params = dict(params or {})
         self.check_parameters(params)
@@ -232,13 +236,17 @@ class FmuRunner:
             raise ValueError(f"stop_time - start_time = {stop_time - start_time} is not a whole number of "
                              f"output intervals {output_interval}")
         time = start_time + output_interval * np.arange(n + 1)
+        if input_derivatives is not None and (
+                self.interface != "CoSimulation" or hold_inputs or np.shape(input_time) != time.shape
+                or not np.allclose(input_time, time, rtol=0, atol=1e-9 * output_interval)):
+            raise ValueError("input_derivatives need co-simulation with the inputs on the communication grid")
         try:
             fmu = self.instance()
             self._state["log"].clear()
             fmu.reset()
             if self.interface == "CoSimulation":
                 vals = self._run_cs(fmu, time, outputs, params, inputs, input_time, tolerance, hold_inputs,
-                                    max_wall_s)
+                                    max_wall_s, input_derivatives)
             else:
                 vals = self._run_me(fmu, time, outputs, params, inputs, input_time, tolerance, max_wall_s)
         except (FMICallException, OSError, RuntimeError) as exc:
@@ -251,7 +259,7 @@ class FmuRunner:
         return SimulationResult(time, vals)
 
     def _run_cs(self, fmu, time, outputs, params, inputs, input_time, tolerance, hold_inputs=False,
-                max_wall_s=None):
+                max_wall_s=None, input_derivatives=None):
         fmu.setupExperiment(tolerance=tolerance, startTime=time[0])
         self.set_parameters(fmu, params)
         fmu.enterInitializationMode()
@@ -265,13 +273,18 @@ class FmuRunner:
             in_vr = (ctypes.c_uint * k)(*[self.variables[nm].valueReference for nm in in_names])
             table = np.vstack([np.asarray(inputs[nm], float) for nm in in_names])
             u_at, slope = input_rows(table, np.asarray(input_time, float), time)
+        curv = None
+        if k and input_derivatives is not None:
+            first, second = input_derivatives
+            slope = np.vstack([np.asarray(first[nm], float) for nm in in_names])
+            curv = np.vstack([np.asarray(second[nm], float) for nm in in_names])
         loop = cs_loop()
         if loop is not None:
             self._run_cs_compiled(loop, fmu, time, out_vr, result, in_vr if k else None,
-                                  u_at if k else None, None if (hold_inputs or not k) else slope, max_wall_s)
+                                  u_at if k else None, None if (hold_inputs or not k) else slope, max_wall_s, curv)
         else:  # the same loop in Python
             in_buf, der_buf = (ctypes.c_double * k)(), (ctypes.c_double * k)()
-            order = (ctypes.c_int * k)(*([1] * k))
+            order, order2 = (ctypes.c_int * k)(*([1] * k)), (ctypes.c_int * k)(*([2] * k))
             get_real, do_step = fmu.fmi2GetReal, fmu.fmi2DoStep
             set_real, set_der = fmu.fmi2SetReal, fmu.fmi2SetRealInputDerivatives
             comp = fmu.component
@@ -288,12 +301,15 @@ class FmuRunner:
                     if k and not hold_inputs:
                         der_buf[:] = slope[:, i]
                         set_der(comp, in_vr, k, order, der_buf)
+                        if curv is not None:
+                            der_buf[:] = curv[:, i]
+                            set_der(comp, in_vr, k, order2, der_buf)
                     do_step(comp, t, time[i + 1] - t, 1)
         fmu.terminate()
         return {o: result[:, j].copy() for j, o in enumerate(outputs)}
 
     @staticmethod
-    def _run_cs_compiled(loop, fmu, time, out_vr, result, in_vr, u_at, slope, max_wall_s=None):
+    def _run_cs_compiled(loop, fmu, time, out_vr, result, in_vr, u_at, slope, max_wall_s=None, curv=None):
         """The communication loop of _run_cs in C (pyfit/runtime/cs_driver.c), through the FMU's own functions."""
         def fn(name):
             return ctypes.cast(getattr(fmu.dll, name), ctypes.c_void_p)
@@ -304,10 +320,11 @@ class FmuRunner:
         time = np.ascontiguousarray(time, float)
         u_rows = None if u_at is None else np.ascontiguousarray(u_at.T)
         s_rows = None if slope is None else np.ascontiguousarray(slope.T)
+        c_rows = None if curv is None or slope is None else np.ascontiguousarray(curv.T)
         status, call = ctypes.c_int(0), ctypes.c_int(0)
         failed = loop(fmu.component, fn("fmi2SetReal"), fn("fmi2GetReal"), fn("fmi2SetRealInputDerivatives"),
                       fn("fmi2DoStep"), len(time), ptr(time), 0 if in_vr is None else len(in_vr),
-                      in_vr, ptr(u_rows), ptr(s_rows), len(out_vr), out_vr, ptr(result),
+                      in_vr, ptr(u_rows), ptr(s_rows), ptr(c_rows), len(out_vr), out_vr, ptr(result),
                       ctypes.byref(status), ctypes.byref(call), float(max_wall_s or 0.0))
         if failed >= 0 and call.value == 5:
             raise RuntimeError(_too_slow(max_wall_s, time[failed]))

@@ -52,7 +52,7 @@ def cs_loop():
             fn = None
         else:
             p, i = ctypes.c_void_p, ctypes.c_int
-            fn.argtypes = [p, p, p, p, p, i, p, i, p, p, p, i, p, p, ctypes.POINTER(i), ctypes.POINTER(i),
+            fn.argtypes = [p, p, p, p, p, i, p, i, p, p, p, p, i, p, p, ctypes.POINTER(i), ctypes.POINTER(i),
                            ctypes.c_double]
             fn.restype = i
         _loaded["fn"] = fn
