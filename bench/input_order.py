@@ -21,8 +21,9 @@ import numpy as np
 
 from pyfit.gap import simulate as sim
 from pyfit.gap.datasets import FAMILIES, LabStyle, write_dataset
-from pyfit.gap.diagnose import DiagnoseConfig, _load, fmu_defaults
+from pyfit.gap.diagnose import fmu_defaults
 from pyfit.gap.systems import family_fmu, make_system
+from pyfit.io.data import read_dataset_with_order
 from pyfit.report.generated import BenchReport
 from pyfit.runtime import drive
 from pyfit.runtime.examples import ensure_fmu
@@ -44,7 +45,8 @@ def main():
             data = write_dataset(pathlib.Path(tmp) / "data", FAMILIES[model], withheld, style=style)
             runner = FmuRunner(str(ensure_fmu(family_fmu(model), ROOT / "fmus")))
             system = make_system(model, fmu_defaults(runner), None)
-            records, *_ = _load(data, system, DiagnoseConfig(), runner)
+            records = [sim.record_of(m, system.motion_inputs, smooth_inputs=system.smooth_inputs)
+                       for m in read_dataset_with_order(data)[0]]
             truth = {**system.nominal_fixed, **json.loads((data / "truth.json").read_text())["params"]}
             fine = [sim.simulate(runner, dataclasses.replace(r, smooth_inputs=True), truth, 32, system.lead_periods,
                                  1e-9) for r in records]
@@ -60,7 +62,7 @@ def main():
                 error = max(np.sqrt(np.mean([np.mean((o[k] - f[k]) ** 2) / np.mean(f[k] ** 2) for k in f]))
                             for o, f in zip(outs, fine))
                 chosen = (kind == "spline") == system.smooth_inputs and upsample == system.upsample and \
-                    tolerance == (sim.SPLINE_TOLERANCE if system.smooth_inputs else sim.TOLERANCE)
+                    tolerance == sim.tolerance_of(records[0])
                 rows.append([kind, f"{upsample} x", f"{tolerance:g}", f"{error:.1e}", f"{np.mean(walls):.3f}",
                              "yes" if chosen else ""])
             runner.close()

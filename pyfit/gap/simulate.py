@@ -121,15 +121,21 @@ SPLINE_TOLERANCE = 1e-5
 MAX_WALL_S = 60.0
 
 
+def tolerance_of(rec: Record) -> float:
+    """The integrator's relative tolerance a diagnosis simulates a record at: SPLINE_TOLERANCE when its inputs'
+    spline drives the FMU, else TOLERANCE."""
+    return SPLINE_TOLERANCE if rec.smooth_inputs else TOLERANCE
+
+
 def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, lead_periods: int = 1,
              tolerance: float | None = None, outputs=None) -> dict | None:
     """Outputs (model variable -> the compared samples of the record's grid, less their mean; default: the
     record's outputs) for FMU parameters params; None on failure. A periodic record is driven by its period
     averaged over the record (pyfit.runtime.drive): its steady state, one period simulated after lead_periods
-    (at least one) and repeated over the record's periods. tolerance: the integrator's (None: SPLINE_TOLERANCE
-    for a record driven by its inputs' spline, else TOLERANCE)."""
+    (at least one) and repeated over the record's periods. tolerance: the integrator's (None: the record's,
+    tolerance_of)."""
     if tolerance is None:
-        tolerance = SPLINE_TOLERANCE if rec.smooth_inputs else TOLERANCE
+        tolerance = tolerance_of(rec)
     params = dict(params)
     delay = params.pop(SENSOR_DELAY, 0.0)  # not an FMU parameter: a lag of the output channels behind the inputs
     inputs, repeat = rec.inputs, 1

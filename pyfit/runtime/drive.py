@@ -56,12 +56,17 @@ def remembered_fine_inputs(inputs: dict[str, np.ndarray], upsample: int, samples
     changed in place is upsampled anew); the arrays returned are shared between calls: read them only.
     source: digest(inputs as float arrays), when the caller has it already."""
     arrays = {k: np.asarray(v, float) for k, v in inputs.items()}
-    key = digest(source or digest(arrays), int(upsample), samples_per_period or 0, lead_periods)
+    key = _fine_key(source or digest(arrays), upsample, samples_per_period, lead_periods)
     found = FINE_MEMO.get(key)
     if found is None:
         found = fine_inputs(arrays, upsample, samples_per_period, lead_periods)
         FINE_MEMO.put(key, found, sum(v.nbytes for v in found[0].values()))
     return found
+
+
+def _fine_key(source: str, upsample: int, samples_per_period: int | None, lead_periods: int) -> str:
+    """What names a record's upsampled inputs in FINE_MEMO: its inputs' digest and how they were upsampled."""
+    return digest(source, int(upsample), samples_per_period or 0, lead_periods)
 
 
 def remembered_derivatives(fine: dict[str, np.ndarray], dt: float, key: str) -> tuple[dict, dict]:
@@ -113,8 +118,8 @@ def _driven(runner: FmuRunner, inputs: dict[str, np.ndarray], fs: float, outputs
     n_fine = len(next(iter(fine.values())))
     dt = 1.0 / (fs * upsample)
     t = np.arange(n_fine) * dt
-    derivatives = remembered_derivatives(fine, dt, digest(source, int(upsample), samples_per_period or 0,
-                                                          lead_periods)) if smooth_inputs else None
+    derivatives = remembered_derivatives(fine, dt, _fine_key(source, upsample, samples_per_period, lead_periods)) \
+        if smooth_inputs else None
     res = runner.simulate(t[-1], dt, list(outputs), params, inputs=fine, input_time=t, tolerance=tolerance,
                           max_wall_s=max_wall_s, input_derivatives=derivatives)
     grid = np.arange(n) / fs
