@@ -146,3 +146,24 @@ def test_a_refit_finds_a_gap_below_the_noise_threshold_only_when_it_carries_over
     edge = (1.0 - cut) * 0.01
     assert selection.detected_by_refit(0.01, edge, cut) and not selection.detected_by_refit(0.01, 1.001 * edge, cut)
     assert not selection.detected_by_refit(0.0, 0.0, cut)  # no misfit: nothing to find
+
+
+def test_a_pairs_shares_of_the_shrink_do_not_depend_on_which_member_was_found_first():
+    # damper campaign case 24: cubic springs alone worsen the held-out sweep (shrink -31.5 %), the loop alone
+    # barely moves it (0.2 %), the pair removes 99.3 %. Each member's share is what it adds averaged over both
+    # orders: springs (-31.5 + (99.3 - 0.2)) / 2, loop (0.2 + (99.3 + 31.5)) / 2
+    shrink = {frozenset(["cubic_stiffness"]): -31.5, frozenset(["hysteresis"]): 0.2,
+              frozenset(["cubic_stiffness", "hysteresis"]): 99.3}
+    shares = selection.member_shares(["cubic_stiffness", "hysteresis"], shrink.get)
+    assert shares == pytest.approx({"cubic_stiffness": 33.8, "hysteresis": 65.5}, abs=1e-9)
+    assert selection.member_shares(["hysteresis", "cubic_stiffness"], shrink.get) == pytest.approx(shares)
+    # three members, every sub-model refitted: the shares sum to the whole, and two members that add the same to
+    # every model get the same share
+    three = {frozenset(s): v for s, v in [("a", 10.0), ("b", 10.0), ("c", 40.0), ("ab", 30.0), ("ac", 60.0),
+                                          ("bc", 60.0), ("abc", 90.0)]}
+    shares = selection.member_shares(list("abc"), three.get)
+    assert sum(shares.values()) == pytest.approx(90.0) and shares["a"] == pytest.approx(shares["b"])
+    assert shares["c"] == pytest.approx((40.0 + 50.0 + 50.0 + 60.0 + 40.0 + 60.0) / 6)
+    # a sub-model not refitted: each member what it adds to the ones before it, in the order given
+    partial = {frozenset("ab"): 80.0, frozenset("a"): 50.0}
+    assert selection.member_shares(list("ab"), partial.get) == pytest.approx({"a": 50.0, "b": 30.0})

@@ -29,6 +29,8 @@ class Fit:
     calibration_nrmse: float
     evaluations: int
     wall_s: float
+    from_envelopes: bool = False  # refitted on the waveforms from a fit to the amplitude envelopes (the diagnosis's
+    # envelope-led stage, when no model refitted on the waveforms alone explained the data)
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -58,6 +60,8 @@ class FitTask:
     # function, so the task pickles to a worker)
     probes: int = 1  # without a basin: the best starts descended before the best of them goes on
     probed: tuple = ()  # starts (dicts of parameter overrides) descended as probes too, whatever their misfit
+    envelopes: bool = False  # minimise the amplitude envelopes' residual (sim.envelope_residuals), not the
+    # waveforms': starts ranked, stages and least squares on it (the Fit's calibration_nrmse is then the envelopes')
 
 
 class UnitScaling:
@@ -123,7 +127,7 @@ def run_fit(task: FitTask) -> Fit:
     has one at each ν, which sets the scale of β, and width: systems.sdof_loop_basin), each with BASIN_SHARE
     of the budget first, then the BASINS_ON best of them each with the whole budget; without it, likewise from the
     task.probes best starts and task.probed (a combination's starts lead to different local optima of its many
-    parameters)."""
+    parameters). With task.envelopes, all of it on the amplitude envelopes instead of the waveforms."""
     t0 = time.perf_counter()
     threads = max(1, min(task.threads, len(task.records)))
     runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
@@ -134,7 +138,9 @@ def run_fit(task: FitTask) -> Fit:
     def params(x):
         return with_derived({**task.fixed, **unit.values(x)}, task.derived)
 
-    def residuals(p, records=task.records, of=sim.residuals, upsample=task.upsample):
+    objective = sim.envelope_residuals if task.envelopes else sim.residuals
+
+    def residuals(p, records=task.records, of=objective, upsample=task.upsample):
         return _stacked(runner, records, p, upsample, task.lead_periods, pool, of)
 
     def cost(x, upsample=task.upsample):
@@ -156,14 +162,14 @@ def run_fit(task: FitTask) -> Fit:
     errors = [cost(x) if k in kept else np.inf for k, x in enumerate(candidates)]
     used += len(kept)
     stages = []
-    if task.continuation and not any(r.periodic for r in task.records):
+    if task.continuation and not task.envelopes and not any(r.periodic for r in task.records):
         # a sweep's envelopes first (all levels): smooth in the parameters where the waveform is not
         stages.append((task.records, sim.envelope_residuals, 3))
     levels = sorted({r.level_value for r in task.records})
     if task.continuation and len(levels) > 1:
         # continuation in amplitude: the lowest level alone, where an amplitude-dependent effect is weakest
         # and the residual smooth in the parameters (a hardening spring jumps on a sweep at the highest level)
-        stages.append(([r for r in task.records if r.level_value == levels[0]], sim.residuals, 4))
+        stages.append(([r for r in task.records if r.level_value == levels[0]], objective, 4))
 
     def descend(x0, e0, budget):
         """The stages (each 1/part of the budget) then least squares on every record with what is left, each

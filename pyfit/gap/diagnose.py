@@ -9,6 +9,7 @@ import os
 import pathlib
 import dataclasses
 import functools
+import itertools
 from dataclasses import asdict, dataclass, fields
 
 
@@ -278,7 +279,10 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     and not the model selected meets the absolute criterion, the `cfg.grid_models` models with the lowest
     held-out misfit are each refitted from the best point of a grid over their members' strengths
     (systems.strength_grid; a pair's valley where a descent from its members' refits stops short), and the
-    selection is made again with them. Adds the fits and held-out
+    selection is made again with them. When still nothing meets it and the calibration records are not periodic
+    (sweeps, stepped sines, noise), the single effects and pairs of the best of them are fitted to the amplitude
+    envelopes first and refitted on the waveforms from there (enveloped, below), and the selection weighs those
+    pairs too. Adds the fits and held-out
     simulations to `fits` and `sims`; returns the system with the combined effects among its effects and the
     model selected (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
@@ -475,6 +479,63 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     def found_beside(end):  # such a loop, found beside the lean effect its path began at
         return basin_free_stand_in(end) and not system.effects[(effects[end].members or (end,))[0]].free_shape
 
+    def envelope_fits(models, seeds_of, probes=1, stored_as="envelopes"):
+        # each model fitted to the calibration files' amplitude envelopes from its starts and `seeds_of(model)`
+        # (attribute.FitTask.envelopes), stored as fits/<model>.<stored_as>.json
+        return _fits_of([(dataclasses.replace(effect_task(system, effects[n], fmu, cal, nominal, scale,
+                                                          cfg.refit_budget, cfg.upsample, seeds=seeds_of(n)),
+                                              envelopes=True, probes=probes),
+                          out / "fits" / f"{_stem(n)}.{stored_as}.json") for n in models],
+                        key, alone, workers, progress, "envelope fits")
+
+    def enveloped(models):
+        # nothing explains a sweep or stepped sine: the waveform refits can all stop a cycle or more off the data
+        # (a strong hardening spring beside a loop jumps at another frequency in every refit, and no single
+        # effect, nor a pair built from them, comes near), where the amplitude envelopes are smooth in the
+        # parameters. Each single effect is fitted to the envelopes (from its starts and its waveform refit);
+        # each pair of the `cfg.grid_models` best of them by that fit twice, from its members' waveform refits
+        # and from their envelope fits (_combination_seeds of each: the envelopes have basins of their own, a
+        # loop's shape barely changes them). Each model is then refitted on the waveforms from its envelope
+        # fit(s) (both descended a while, the better one on), replacing its fit when that fits the calibration
+        # files better. Returns the pairs (the models the selection also weighs)
+        alone_fits = envelope_fits(models, lambda n: (fits[n].params,))
+        best = sorted(alone_fits, key=lambda n: alone_fits[n].calibration_nrmse)[:cfg.grid_models]
+        pairs = []
+        for a, b in itertools.combinations(best, 2):
+            together = frozenset([a, b])
+            if together not in named:
+                combo = combine([system.effects[a], system.effects[b]])
+                effects[combo.name], named[together] = combo, combo.name
+            pairs.append(named[together])
+
+        def seeds_from(members_fits):  # a pair's starts from its members' fits (_combination_seeds)
+            def seeds(pair):
+                first, second = effects[pair].members
+                return _combination_seeds(system, scale, members_fits[first].params, [first],
+                                          members_fits[second].params, second, {})
+            return seeds
+
+        on_envelopes = {n: [f] for n, f in alone_fits.items()}
+        for members_fits, stored_as in ((fits, "envelopes"), (alone_fits, "envelopes_from_envelopes")):
+            for name, fit in envelope_fits(pairs, seeds_from(members_fits), cfg.combination_probes,
+                                           stored_as).items():
+                on_envelopes.setdefault(name, []).append(fit)
+        jobs = []
+        for name, found in on_envelopes.items():
+            task = effect_task(system, effects[name], fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample)
+            values = [{n: f.params[n] for n in task.start} for f in found]
+            jobs.append((dataclasses.replace(task, start=values[0], alternatives=tuple(values[1:]), basin=None,
+                                             probes=len(values), continuation=False),
+                         out / "fits" / f"{_stem(name)}.from_envelopes.json"))
+        for name, fit in _fits_of(jobs, key, alone, workers, progress, "waveforms from the envelopes").items():
+            if name not in fits or fit.calibration_nrmse < fits[name].calibration_nrmse:
+                # its cost includes the envelope fits it starts from
+                fits[name] = dataclasses.replace(fit, evaluations=fit.evaluations + sum(
+                    f.evaluations for f in on_envelopes[name]), wall_s=fit.wall_s + sum(
+                    f.wall_s for f in on_envelopes[name]), from_envelopes=True)
+                simulated(name)
+        return pairs
+
     ends, starts = [], ranked[:cfg.beam]
     screened = max(ranked, key=lambda n: screening.get(n, 0.0))  # the single effects, by their sensitivity
     if (basin_free_stand_in(starts[0]) and screened != starts[0]
@@ -506,6 +567,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             onward(name, fits[name].params, cfg.refit_budget, f"{_stem(name)}.gridded",
                    strength_grid(members, scale, fits[name].params))
         selected = functools.reduce(kept, ends + [n for n in gridded if n not in ends])
+    if all(after[n] > explained_below for n in singles + [selected]) and not any(r.periodic for r in cal):
+        selected = functools.reduce(kept, [selected] + enveloped(singles))
     return dataclasses.replace(system, effects=effects), selected
 
 

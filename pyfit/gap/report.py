@@ -164,17 +164,13 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
                         "shrink_pct": selection.shrink_pct(before, after, reference), "params": _free_values(fit),
                         "n_added_params": fit.n_added, "screening_explained": screening.get(name),
                         "calibration_nrmse": fit.calibration_nrmse, "evaluations": fit.evaluations,
-                        "wall_s": fit.wall_s})
+                        "wall_s": fit.wall_s, "from_envelopes": fit.from_envelopes})
     explained_below = selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin)
+    shrinks = {frozenset(d["members"]): d["shrink_pct"] for d in ranking}
     for d in ranking:
         d["explains"] = bool(d["shrink_pct"] >= cfg.min_shrink_pct and d["heldout_gap_after"] <= explained_below)
-        if len(d["members"]) > 1:  # each member's share: its own refit's shrink, then what each addition adds
-            shares, done = {}, 0.0
-            for k in range(len(d["members"])):
-                part = " + ".join(d["members"][:k + 1])
-                total = next((r["shrink_pct"] for r in ranking if r["effect"] == part), d["shrink_pct"])
-                shares[d["members"][k]], done = total - done, total
-            d["member_shares_pct"] = shares
+        if len(d["members"]) > 1:  # each member's share (selection.member_shares)
+            d["member_shares_pct"] = selection.member_shares(d["members"], shrinks.get)
     for d in ranking:
         d["kept"] = len(d["members"]) == 1 or d["effect"] == selected
     # the model the selection kept if it explains the gap, else the best-scoring one that does, else the
@@ -219,7 +215,10 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
         if len(best["members"]) > 1:
             evidence.append("share of the shrink: " + ", ".join(
                 f"{m} {v:.1f} %" for m, v in best["member_shares_pct"].items())
-                + " (the first alone, then what each addition adds)")
+                + " (what each adds, averaged over the orders they can be added in)")
+        if best.get("from_envelopes"):
+            evidence.append("found by the envelope-led stage: fitted to the amplitude envelopes first, then on the "
+                            "waveforms from there (no model refitted on the waveforms alone explained the data)")
         evidence += [
             f"screening: the sensitivity of {m} explains {100 * screening[m]:.1f} % of the nominal residual "
             f"(rank {ranked_screen.index(m) + 1} of {len(screening)})" for m in best["members"] if m in screening]

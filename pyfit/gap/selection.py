@@ -2,6 +2,8 @@
 effect combinations (SI units; NRMSE is dimensionless)."""
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from pyfit.gap import localise
@@ -49,6 +51,30 @@ def shrink_pct(before: float, after: float, reference: float) -> float:
 def score(before: float, after: float, reference: float, strengths: int) -> float:
     """Shrink [%] less PENALTY_POINTS per strength parameter beyond the first: what a candidate pays for."""
     return shrink_pct(before, after, reference) - PENALTY_POINTS * (strengths - 1)
+
+
+def member_shares(members: list[str], shrink_of) -> dict[str, float]:
+    """Each member's share of a combination's shrink [%]: its Shapley value, what it adds to the model of the
+    members before it averaged over every order the members can be added in (the model without any shrinks 0),
+    so that the shares sum to the combination's shrink whichever member was found first. `shrink_of(members)`
+    gives the shrink of the model of those members (a frozenset), None where it was not refitted: then each
+    member's share is what it adds to the members before it in the order given (a model not refitted counted
+    at the combination's shrink)."""
+    whole = shrink_of(frozenset(members))
+    values = {frozenset(s): shrink_of(frozenset(s)) for k in range(1, len(members)) for s in
+              itertools.combinations(members, k)}
+    orders = list(itertools.permutations(members)) if None not in values.values() else [tuple(members)]
+    values.update({frozenset(): 0.0, frozenset(members): whole})
+
+    def value(subset):
+        found = values[frozenset(subset)]
+        return whole if found is None else found
+
+    shares = dict.fromkeys(members, 0.0)
+    for order in orders:
+        for k, m in enumerate(order):
+            shares[m] += (value(order[:k + 1]) - value(order[:k])) / len(orders)
+    return shares
 
 
 def adds_enough(smaller_after: float, larger_after: float, floor: float, min_excess_cut: float) -> bool:
