@@ -522,9 +522,11 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 on_envelopes.setdefault(name, []).append(fit)
         jobs = []
         for name, found in on_envelopes.items():
-            task = effect_task(system, effects[name], fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample)
-            values = [{n: f.params[n] for n in task.start} for f in found]
-            jobs.append((dataclasses.replace(task, start=values[0], alternatives=tuple(values[1:]), basin=None,
+            # the envelope fits as seeds: the bounds widened to hold their linear values, then the starts
+            task = effect_task(system, effects[name], fmu, cal, nominal, scale, cfg.refit_budget, cfg.upsample,
+                               seeds=tuple(f.params for f in found))
+            values = task.alternatives[-len(found):]
+            jobs.append((dataclasses.replace(task, start=values[0], alternatives=values[1:], basin=None,
                                              probes=len(values), continuation=False),
                          out / "fits" / f"{_stem(name)}.from_envelopes.json"))
         for name, fit in _fits_of(jobs, key, alone, workers, progress, "waveforms from the envelopes").items():
