@@ -49,36 +49,34 @@ def test_drawn_dampers_span_the_catalogue_and_their_band_holds_two_resonances():
                          for lp in loops)
 
 
-@pytest.mark.parametrize("config", [None, "diagnose_nominal_threshold.toml"])
-def test_a_campaign_read_back_states_every_report_with_the_calibration_it_reads(tmp_path, config):
+@pytest.mark.parametrize("config, model", [(None, "sdof"), ("diagnose_nominal_threshold.toml", "sdof"),
+                                           (None, "damper")])
+def test_a_campaign_read_back_states_every_report_with_the_calibration_it_reads(tmp_path, config, model):
     """Outcomes stored by an earlier run hold the confidence that run's calibration gave; the summary states every
-    report's with the calibration the package carries now for the campaign's settings (the defaults; the
-    nominal's threshold alone, a calibration of its own), as a report diagnosed in this run states it."""
+    report's with the calibration the package carries now for the campaign's family and settings (the SDOF's
+    defaults; the nominal's threshold alone, a calibration of its own; the damper's defaults, another family's),
+    as a report diagnosed in this run states it."""
     from dataclasses import asdict
 
     from pyfit.gap.diagnose import DiagnoseConfig, load_config, with_family_drive
 
     path = None if config is None else str(ROOT / "configs" / config)
     package = confidence.load(confidence.settings_of(asdict(with_family_drive(
-        load_config(path) if path else DiagnoseConfig(), "sdof"))))
-    for c in campaign.draw(3, seed=0):
+        load_config(path) if path else DiagnoseConfig(), model))), model)
+    assert package is not None and package["model"] == model
+    for c in campaign.draw(3, seed=0, model=model):
         named = c.withheld
         (tmp_path / f"case{c.index:04d}").mkdir()
         (tmp_path / f"case{c.index:04d}" / "outcome.json").write_text(json.dumps(
             {"named": named, "withheld": c.withheld, "enr": 20.0, "top_shrink_pct": None if named == "none" else 99.0,
              "verdict": "no significant gap" if named == "none" else f"gap explained by {named}", "stated": 0.01,
              "data_s": 1.0, "diagnose_s": 2.0, "case": asdict(c)}))
-    campaign.run(3, tmp_path, seed=0, workers=1, progress=False, config=path)
+    campaign.run(3, tmp_path, seed=0, workers=1, progress=False, config=path, model=model)
     stored = json.loads((tmp_path / "summary.json").read_text())
     assert stored["resumed"] == 3 and stored["stated_from"]["source"] == package["source"]
     for o in stored["outcomes"]:
         chosen = None if o["named"] == "none" else o["named"]
         assert o["stated"] == confidence.stated(o["verdict"], chosen, o["top_shrink_pct"], package)["rate"] != 0.01
-
-
-def test_calibrating_on_damper_cases_is_refused(tmp_path):
-    with pytest.raises(ValueError, match="calibration is of sdof cases"):
-        campaign.run(2, tmp_path, calibrate=True, model="damper")
 
 
 def test_no_drawn_loop_sits_at_a_start_of_the_candidate():

@@ -71,10 +71,14 @@ def test_a_calibration_is_read_for_the_settings_it_was_made_with_only(tmp_path):
     confidence.write(confidence.calibration_of(OUTCOMES, "default settings", 4, default), path)
     confidence.write(confidence.calibration_of(OUTCOMES[:3], "other settings", 4, other), path)
     confidence.write(confidence.calibration_of(OUTCOMES[:5], "other settings, again", 4, other), path)  # replaces
-    assert confidence.load(default, path)["cases"] == 17
-    assert (confidence.load(other, path)["source"], confidence.load(other, path)["cases"]) == ("other settings, again", 5)
-    assert confidence.load({"refit_within_noise": True, "min_gap": 0.01}, path) is None
-    assert confidence.load({"refit_within_noise": True}, path) is None  # a setting it was not made with
+    confidence.write(confidence.calibration_of(OUTCOMES[:7], "damper cases", 4, default, model="damper"), path)
+    assert confidence.load(default, path=path)["cases"] == 17
+    again = confidence.load(other, path=path)
+    assert (again["source"], again["cases"]) == ("other settings, again", 5)
+    # a calibration is of one system family: a damper's does not replace, nor stand for, the SDOF's
+    assert confidence.load(default, "damper", path)["cases"] == 7 and confidence.load(other, "damper", path) is None
+    assert confidence.load({"refit_within_noise": True, "min_gap": 0.01}, path=path) is None
+    assert confidence.load({"refit_within_noise": True}, path=path) is None  # a setting it was not made with
     # where the files are (which are calibrated on, the bands) is no setting of the rule
     assert confidence.settings_of({"min_gap": 0.005, "calibration": ["a"], "bands_hz": None}) == {"min_gap": 0.005}
 
@@ -84,7 +88,7 @@ def test_the_package_carries_a_calibration_of_the_default_settings_from_a_campai
 
     from pyfit.gap.diagnose import DiagnoseConfig, with_family_drive
 
-    cal = confidence.load(confidence.settings_of(asdict(with_family_drive(DiagnoseConfig(), confidence.FAMILY))))
+    cal = confidence.load(confidence.settings_of(asdict(with_family_drive(DiagnoseConfig(), "sdof"))))
     assert cal is not None and cal["source"].startswith("stockbridge diagnose --campaign ")
     assert sum(r["named"] for r in cal["by_shrink"]) + cal["no_gap"]["verdicts"] <= cal["cases"]
     assert np.all([0 <= r["right"] <= r["named"] for r in cal["by_shrink"]])

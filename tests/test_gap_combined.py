@@ -60,7 +60,8 @@ def test_a_strong_element_with_a_wide_loop_on_long_sweeps_is_named_alone(tmp_pat
     turns over far beyond the data's force (1-3 kN: a wide loop, a little hysteretic damping), drawn at random.
     A weak element with a narrow loop has the same first-order nonlinearity (α·β·γ) and is another basin of
     the least squares; refitted from there the loop leaves a misfit a cubic spring absorbs, and the pair is
-    named. Named alone, within 1.2x the noise floor on the held-out file."""
+    named; or the loop alone stays narrow while its pair with a partner of next to nothing holds the wide loop
+    (the model so far then takes that loop). Named alone, within 1.2x the noise floor on the held-out file."""
     rng = np.random.default_rng(SEED + 3)
     nu = float(rng.uniform(1.0, 1.4))
     k = 1e5 * float(rng.uniform(0.4, 0.6))

@@ -53,8 +53,8 @@ def add_arguments(ap) -> None:
                     "OUT/summary.md; resumes")
     ap.add_argument("--campaign-seed", type=int, default=0, help="with --campaign: the draw's seed")
     ap.add_argument("--calibrate", action="store_true", help="with --campaign: its hit rates become the confidence "
-                    "every later report with the same settings (--config) states (stored in the package: "
-                    "pyfit/gap/calibration.json, one calibration per set of settings)")
+                    "every later report of the same --model with the same settings (--config) states (stored in the "
+                    "package: pyfit/gap/calibration.json, one calibration per family and set of settings)")
     ap.add_argument("--scheduler", help="with --campaign: a Dask scheduler address (default: a LocalCluster of "
                                         "--workers processes, 2 if not given)")
     ap.add_argument("--motion", default="xva", help="with --make-datasets --model damper: which of the clamp's "

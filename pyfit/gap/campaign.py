@@ -227,18 +227,14 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     """Draw n cases of `model` and diagnose them: on `scheduler` (a Dask scheduler address) when given, else on
     a Dask LocalCluster of `workers` single-threaded processes. Writes OUT/summary.md and OUT/summary.json (a
     campaign whose every case is stored is summarised again, with the wall time of the run that diagnosed them);
-    with `calibrate` (SDOF cases only: the confidence is stated for SDOF diagnoses), its hit rates become the
-    package's confidence calibration of its settings (pyfit.gap.confidence), and the summary states every report's
-    confidence with it (in-sample); `config`: a TOML file of diagnosis settings (pyfit.gap.diagnose.load_config;
-    default: the defaults)."""
-    if calibrate and model != confidence.FAMILY:
-        raise ValueError(f"--calibrate: the package's calibration is of {confidence.FAMILY} cases; the campaign "
-                         f"is of {model}")
+    with `calibrate`, its hit rates become the package's confidence calibration of `model` with its settings
+    (pyfit.gap.confidence), and the summary states every report's confidence with it (in-sample); `config`: a
+    TOML file of diagnosis settings (pyfit.gap.diagnose.load_config; default: the defaults)."""
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     cfg = with_family_drive(load_config(config) if config else DiagnoseConfig(), model)
     settings = confidence.settings_of(asdict(cfg))
-    stated_from = confidence.load(settings) if model == confidence.FAMILY else None
+    stated_from = confidence.load(settings, model)
     jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg) for c in draw(n, seed, model)]
     # cases an earlier run finished (interrupted, or a rerun of only some cases): read, not diagnosed again, so this
     # run's wall time does not cover them
@@ -264,7 +260,7 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
         # before it): with this run's, a full run's wall time at most
         run_by["earlier_wall_s"] = earlier["wall_s"] + earlier.get("earlier_wall_s", 0.0)
     if calibrate:
-        stated_from = confidence.calibration_of(outcomes, command(n, seed, model, config), seed, settings)
+        stated_from = confidence.calibration_of(outcomes, command(n, seed, model, config), seed, settings, model)
         confidence.write(stated_from)
     # every report's confidence as stated with the calibration this run reads or writes (an outcome read from an
     # earlier run holds the one that run read)

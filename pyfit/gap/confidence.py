@@ -4,12 +4,12 @@ The campaign counts, per bin of the named model's held-out shrink, how many repo
 of those were right; and how many 'no significant gap' verdicts had nothing withheld. A single report states the
 hit rate of its bin as the centre of the Wilson 95 % interval of that count, with the interval (few cases give
 a wide interval, and the report says so; the centre keeps a bin of one or two reports from stating 0 or 100 %).
-A hit rate is a property of the decision rule as much as of the data: the package carries one calibration per
-set of diagnosis settings a campaign was run with (calibration.json beside this module, written by
-`stockbridge diagnose --campaign N [--config FILE] --calibrate`), and a report states the confidence of the one
-whose settings equal its own (settings_of: every setting but the ones that only say where the data are), none
-when no campaign was run with them. A campaign with other cases checks how well the stated confidence matches
-what happens.
+A hit rate is a property of the decision rule and of the system as much as of the data: the package carries one
+calibration per system family and set of diagnosis settings a campaign was run with (calibration.json beside
+this module, written by `stockbridge diagnose --campaign N [--model M] [--config FILE] --calibrate`), and a
+report states the confidence of the one of its own family whose settings equal its own (settings_of: every
+setting but the ones that only say where the data are), none when no campaign was run with them. A campaign
+with other cases checks how well the stated confidence matches what happens.
 """
 from __future__ import annotations
 
@@ -21,7 +21,6 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 CALIBRATION = pathlib.Path(__file__).with_name("calibration.json")
-FAMILY = "sdof"  # the system the calibration's campaign draws: a diagnosis of another states no confidence
 SHRINK_BINS = (-np.inf, 50.0, 80.0, 95.0, np.inf)  # the named model's held-out shrink [%]
 STATED_BINS = (0.0, 0.5, 0.8, 0.95, 1.0 + 1e-9)  # stated confidence, for the check against the hit rate
 # diagnosis settings that say which files are which and what is compared, not how a verdict is reached
@@ -86,9 +85,10 @@ def settings_of(config: dict) -> dict:
     return {k: v for k, v in config.items() if k not in LAYOUT_SETTINGS}
 
 
-def calibration_of(outcomes: list[dict], source: str, seed: int, settings: dict | None = None) -> dict:
-    """The calibration table of a campaign's outcomes (each: named, withheld, verdict, top_shrink_pct), run with
-    `settings` (settings_of)."""
+def calibration_of(outcomes: list[dict], source: str, seed: int, settings: dict | None = None,
+                   model: str = "sdof") -> dict:
+    """The calibration table of a campaign's outcomes (each: named, withheld, verdict, top_shrink_pct) of
+    `model` cases (a system family: pyfit.gap.systems.FAMILY), run with `settings` (settings_of)."""
     named = [o for o in outcomes if o["named"] not in ("none", "error")]
     by_shrink = []
     for k in range(len(SHRINK_BINS) - 1):
@@ -96,7 +96,7 @@ def calibration_of(outcomes: list[dict], source: str, seed: int, settings: dict 
         by_shrink.append({"shrink_pct": [SHRINK_BINS[k], SHRINK_BINS[k + 1]], "named": len(inside),
                           "right": sum(o["named"] == o["withheld"] for o in inside)})
     quiet = [o for o in outcomes if o["verdict"] == "no significant gap"]
-    return {"source": source, "seed": seed, "cases": len(outcomes), "settings": settings or {},
+    return {"source": source, "seed": seed, "cases": len(outcomes), "model": model, "settings": settings or {},
             "by_shrink": by_shrink,
             "no_gap": {"verdicts": len(quiet), "right": sum(o["withheld"] == "none" for o in quiet)}}
 
@@ -106,16 +106,16 @@ def _stored(path: pathlib.Path) -> list[dict]:
 
 
 def write(calibration: dict, path: pathlib.Path = CALIBRATION) -> pathlib.Path:
-    """Store a calibration (in the package's file by default), in place of one with the same settings."""
-    kept = [c for c in _stored(path) if c["settings"] != calibration["settings"]]
+    """Store a calibration (in the package's file by default), in place of one of the same family and settings."""
+    kept = [c for c in _stored(path) if (c["model"], c["settings"]) != (calibration["model"], calibration["settings"])]
     path.write_text(json.dumps({"calibrations": kept + [calibration]}, indent=1, default=float) + "\n")
     return path
 
 
-def load(settings: dict, path: pathlib.Path = CALIBRATION) -> dict | None:
-    """The stored calibration of these settings (settings_of), None when no campaign was run with them (a setting
-    added since a calibration was made counts as another setting)."""
-    return next((c for c in _stored(path) if c["settings"] == settings), None)
+def load(settings: dict, model: str = "sdof", path: pathlib.Path = CALIBRATION) -> dict | None:
+    """The stored calibration of `model` cases with these settings (settings_of), None when no campaign of that
+    family was run with them (a setting added since a calibration was made counts as another setting)."""
+    return next((c for c in _stored(path) if c["model"] == model and c["settings"] == settings), None)
 
 
 def stated(verdict: str, chosen: str | None, shrink_pct: float | None, calibration: dict | None) -> dict | None:

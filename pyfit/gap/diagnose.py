@@ -258,7 +258,9 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     the floor that the model it extends leaves once refitted on with a combination's budget (the combinations
     start from that refit and never end worse than it) or, when lower, the misfit of the control's joint refit
     (what the combination's extra evaluations alone buy the model it extends, counted with the control's partner
-    at zero: selection.budget_control), up to `cfg.max_effects` members.
+    at zero: selection.budget_control), up to `cfg.max_effects` members. Where the control at zero fits the
+    held-out files better than the model it extends, that model is refitted on from there (and takes the fit
+    when it fits the calibration files better): the longer fit the control stands for.
     The noise these tests measure a misfit above is the floor should the sensor noise grow with the level
     (gap["noise_floor_scaled"]): a floor taken too low asks a right pair to remove half of a misfit that is noise.
     A path's end is checked backward: the model without its last-added member is refitted from the end's
@@ -418,8 +420,15 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             best = functools.reduce(kept, names) if names else None  # the lowest misfit, or the leanest at the noise
             least = order[-1] if order else None
             tried = {n: (task, side) for n, task, _, side in new}
-            control = selection.budget_control(without_partner(least, *tried[least]), len(names)) \
-                if least not in (None, best) else float("inf")
+            at_zero = without_partner(least, *tried[least]) if least not in (None, best) else float("inf")
+            if at_zero < after[current]:
+                # the control with its partner at zero is the model so far at other values (a wide loop, where
+                # the model's own refit stopped in a narrow one): refitted on from there, it replaces the model's
+                # fit when it fits the calibration files better (the longer fit the control stands for, taken)
+                task, side = tried[least]
+                onward(current, {**fits[least].params, **{n: task.floor[n] for n in side}},
+                       cfg.refit_budget // 2, f"{_stem(current)}.from.{_stem(least)}")
+            control = selection.budget_control(at_zero, len(names))
             for name in names:  # the lowest control any of its refits met
                 controls[name] = min(controls.get(name, float("inf")), control)
             if best is None or not selection.adds_enough(min(after[current], controls[best]), after[best], above,
@@ -579,9 +588,10 @@ def _detection(system, fits: dict, sims: dict, held, gap: dict, scale, runner, c
     threshold: the refit that leaves the least held-out misfit, against the nominal's and against that refit's
     own linear values with its effect at zero or reduced to its linear part (Effect.linear_parts: what refitting
     the linear parameters alone buys, and a linear element where the effect acts), by selection.detected_by_refit
-    with `cfg.min_detect_cut`."""
+    with `cfg.min_detect_cut`. A change of the linear system itself (Effect.linear) does not count (its refit
+    takes up the sensor chain's linear part as well): the refit of the others that leaves the least is taken."""
     after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
-    best = min(after, key=after.get)
+    best = min(after, key=lambda n: (system.effects[n].linear, after[n]))
     effect, refit = system.effects[best], fits[best].params
     parts = effect.linear_parts(refit)
     linear_only = min(selection.heldout_nrmse(_simulated(runner, held, {**refit, **values}, system, cfg), held)
@@ -589,7 +599,7 @@ def _detection(system, fits: dict, sims: dict, held, gap: dict, scale, runner, c
     before = min(gap["overall"], linear_only)
     return {"effect": best, "heldout_after": after[best], "linear_only": linear_only, "reduced": bool(parts),
             "cut": 1.0 - after[best] / before if before > 0 else 0.0, "min_cut": cfg.min_detect_cut,
-            "detected": selection.detected_by_refit(before, after[best], cfg.min_detect_cut)}
+            "detected": not effect.linear and selection.detected_by_refit(before, after[best], cfg.min_detect_cut)}
 
 
 def fmu_defaults(runner: FmuRunner) -> dict[str, float]:
@@ -734,7 +744,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     result["level_order"] = level_order
     result["set_aside"] = {name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in aside.items()}
     top = result["ranking"][0]["shrink_pct"] if result["ranking"] else None
-    calibration = confidence.load(confidence.settings_of(asdict(cfg))) if model == confidence.FAMILY else None
+    calibration = confidence.load(confidence.settings_of(asdict(cfg)), model)
     result["confidence"] = confidence.stated(result["verdict"], result["chosen_effect"], top, calibration)
     result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample, system.lead_periods)
     runner.close()
