@@ -37,7 +37,10 @@ def test_a_declared_candidate_has_its_bounds_and_start_from_the_data_scale(tmp_p
     c = user_candidates.load(_write(tmp_path, GOOD))
     (p,) = c.effects["backlash"].params
     assert p.range(Scale(2e-3, 0.1, 1e5, {})) == (0.0, 1e-3, 8e-3)
-    assert c.fmu is None
+    assert c.fmu is None and not c.effects["backlash"].linear  # a candidate tells a gap below the noise by default
+    declared = GOOD.replace('name = "backlash"', 'name = "backlash"\nlinear = true')
+    marked = user_candidates.load(_write(tmp_path, declared))
+    assert marked.effects["backlash"].linear
 
 
 def test_a_declared_friction_ranges_up_to_the_force_of_a_stuck_joint(tmp_path):
@@ -53,6 +56,7 @@ def test_a_declared_friction_ranges_up_to_the_force_of_a_stuck_joint(tmp_path):
     (("name = \"gap_width\"", "name = \"gap_width\"\nshape = true"), "candidate[0].parameter"),
     (("[[candidate]]", "fmu = \"nowhere.fmu\"\n[[candidate]]"), "fmu"),
     (("name = \"backlash\"", "name = \"backlash\"\ncolour = 1"), "candidate[0].colour"),
+    (("name = \"backlash\"", "name = \"backlash\"\nlinear = 1"), "candidate[0].linear"),
 ])
 def test_a_bad_declaration_is_refused_naming_the_file_and_key(tmp_path, change, where):
     path = _write(tmp_path, GOOD.replace(*change))

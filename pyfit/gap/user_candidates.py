@@ -7,6 +7,7 @@ parameters with bounds and a start rule. The diagnosis screens, refits and ranks
     name = "maxwell_damping"
     signature = "stiffness and damping that change with frequency, the same at every level"
     fixed = {}                          # FMU parameters set while the candidate is on
+    linear = false                      # a change of the linear system (tells no gap below the noise threshold)
     [[candidate.parameter]]
     name = "k_m"                        # an FMU parameter; 0 must switch the element off for a strength
     lower = 0.0
@@ -98,7 +99,7 @@ class UserCandidates:
 
 
 _CANDIDATE = {"name": (str, True, None), "signature": (str, False, ""), "fixed": (dict, False, {}),
-              "parameter": (list, True, None)}
+              "linear": (bool, False, False), "parameter": (list, True, None)}
 _PARAMETER = {"name": (str, True, None), "lower": (object, True, None), "start": (object, True, None),
               "upper": (object, True, None), "shape": (bool, False, False), "log": (bool, False, False)}
 
@@ -131,7 +132,7 @@ def load(path) -> UserCandidates:
             fail(path, f"candidate[{i}].parameter", "no strength parameter (every one has shape = true)",
                  "at least one parameter whose zero switches the effect off", CandidateError)
         effects[c["name"]] = Effect(c["name"], tuple(params), fixed=_Fixed(dict(c["fixed"])),
-                                    signature=c["signature"])
+                                    signature=c["signature"], linear=c["linear"])
     return UserCandidates(path, fmu, effects)
 
 
