@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from gap_cases import CI, case
-from pyfit.gap import datasets
+from pyfit.gap import campaign, datasets
 from pyfit.gap import diagnose as dg
 from pyfit.gap import simulate as sim
 from pyfit.gap.systems import sdof_start
@@ -102,12 +102,9 @@ def test_a_linear_candidate_tells_no_gap_below_the_noise_threshold(tmp_path, fmu
     the held-out misfit the nominal leaves within the noise: it takes up part of how the sensor chain and the
     other simulator differ from the FMU, on every file alike. It tells no gap (Effect.linear): 'no significant
     gap', as the nonlinear candidates' refits against their own linear parts say."""
-    from pyfit.gap import campaign
-    from pyfit.gap.diagnose import DiagnoseConfig, with_family_drive
-
     null = campaign.draw(100, seed=1, model="damper")[13]
     assert null.withheld == "none"
-    cfg = with_family_drive(DiagnoseConfig(), "damper")
+    cfg = dg.with_family_drive(dg.DiagnoseConfig(), "damper")
     outcome = campaign.run_case(campaign.CaseJob(null, str(tmp_path), str(fmu_dir), campaign.RECORD_S, cfg))
     assert outcome["named"] == "none" and outcome["verdict"] == "no significant gap", outcome["verdict"]
     rep = json.loads((tmp_path / "case0013" / "diagnosis" / "report.json").read_text())
