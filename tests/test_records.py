@@ -1,5 +1,7 @@
 """Records as a user brings them, prepared for the diagnosis: a segment cut from a long record, a clamp
 motion recorded as one quantity only, channels that are not FMU variables."""
+import time
+
 import numpy as np
 import pytest
 
@@ -166,3 +168,28 @@ def test_a_damper_driven_by_an_integrated_clamp_motion_starts_at_rest_relative_t
     # (without that, 0.11 to 0.34); what is left is the integrated clamp displacement's own error (1-2 %)
     measured(f"the same ({motion} only): x1's NRMSE over the record", float(np.sqrt(np.mean((out["x1"] - rec.outputs["x1"]) ** 2)
                                                               / np.mean(rec.outputs["x1"] ** 2))), 0.03)
+
+
+def test_a_parameter_set_the_integrator_crawls_through_fails_at_a_limit_set_by_the_nominal(tmp_path, runner):
+    """A 4 s force sweep through the SDOF's linear resonance (35.6 Hz, 0.6 mm). A Bouc-Wen loop with
+    β(γ + δ) = 1e10 m⁻¹ yields within 1e-10 m: its z equation has a rate near β(γ + δ)|ẋ| ≈ 1e9 s⁻¹, and the FMU's
+    explicit Dormand-Prince steps stay below ~3/1e9 s, billions of steps for the record (hours). With the limit
+    sim.with_time_limits sets from the linear model's own simulation (SLOW_FACTOR times its time, at least
+    MIN_WALL_S) the run counts as failed within that limit instead of MAX_WALL_S; a strong loop that yields within
+    1e-6 m is no such set and simulates."""
+    fs = 500.0
+    exc = Excitation(2, 50.0, 20.0, 50.0, 1.5)
+    t, y, u = simulate_truth(SyntheticSpec("SDOFBoucWen", exc, 4.0, fs, ["y"], TRUTH, oversample=10,
+                                           passband_ripple_db=0.005))
+    path = write_measurement(tmp_path / "r.csv", "SDOFBoucWen", t, {"F": (u["u"], "N", "u")},
+                             {"Y": (y["y"], "m", "y")})
+    fmu = runner("SDOFBoucWen")
+    rec = sim.record_of(read_measurement(path))
+    assert rec.max_wall_s == sim.MAX_WALL_S
+    limited, = sim.with_time_limits(fmu, [rec], {**TRUTH, "exc_type": 0})
+    assert sim.MIN_WALL_S <= limited.max_wall_s <= 0.1 * sim.MAX_WALL_S  # a 4 s record: well under a second
+    loop = {**TRUTH, "exc_type": 0, "alpha": 5e4, "gamma": 0.5, "delta": 0.5, "nu": 1.0}
+    assert sim.simulate(fmu, limited, {**loop, "beta": 1e6}) is not None
+    t0 = time.perf_counter()
+    assert sim.simulate(fmu, limited, {**loop, "beta": 1e10}) is None
+    assert time.perf_counter() - t0 < 0.25 * sim.MAX_WALL_S  # cut by the record's limit, not the 60 s one

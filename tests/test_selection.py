@@ -91,16 +91,32 @@ def test_a_pair_must_beat_what_refitting_on_alone_buys_the_model_it_extends():
 
 
 def test_the_best_leaner_partner_beside_a_model_is_refitted_jointly_too():
-    """Calibration misfits of the refits beside friction held at its own refit, campaign seed 16 case 194
-    (Coulomb friction with quadratic damping withheld): the free-shape loop (six effect parameters with the
-    friction's two) leaves 0.0300, the true partner (three) 0.0333, a hardening spring 0.0367, a delay
-    0.0370. The loop leads; of the leaner ones the quadratic damping also gets the joint refit. Beside a loop
-    every one-parameter partner is as lean: no other."""
-    order = ["friction + loop", "friction + quadratic", "friction + cubic", "friction + delay"]
-    sizes = {"friction + loop": 6, "friction + quadratic": 3, "friction + cubic": 3, "friction + delay": 3}
-    assert selection.leaner_best(order, sizes) == ["friction + quadratic"]
-    assert selection.leaner_best(order[1:], sizes) == []
-    assert selection.leaner_best([], {}) == []
+    """Calibration misfits of the refits beside a cubic spring held at its own refit (0.05688), case 75 of the SDOF
+    check campaign (`stockbridge diagnose --campaign 100 --campaign-seed 19`; a cubic spring with quadratic damping
+    withheld): the free-shape loop (five parameters with the spring's one) leaves 0.00824, the true partner (two)
+    0.01595, a delay 0.05667, a friction 0.05688. The loop leads; the quadratic damping cuts 84 % of what the loop
+    cuts and also gets the joint refit. Beside a loop every one-parameter partner is as lean: no other."""
+    order = ["cubic + loop", "cubic + quadratic", "cubic + delay", "cubic + friction"]
+    sizes = {"cubic + loop": 5, "cubic + quadratic": 2, "cubic + delay": 2, "cubic + friction": 3}
+    misfit = {"cubic + loop": 0.00824, "cubic + quadratic": 0.01595, "cubic + delay": 0.05667,
+              "cubic + friction": 0.05688}
+    cuts = {n: 0.05688 - v for n, v in misfit.items()}
+    assert selection.leaner_best(order, sizes, cuts) == ["cubic + quadratic"]
+    assert selection.leaner_best(order[1:], sizes, cuts) == []
+    assert selection.leaner_best([], {}, {}) == []
+
+
+def test_a_leaner_partner_that_cuts_little_beside_a_model_is_not_refitted_jointly():
+    """The diagnosis-time bench's pair (the design damper's cubic springs with its loop withheld): beside the
+    springs held at their refit (0.1323), friction (five parameters) leaves 0.0908, the loop (nine) 0.1033, mass
+    offsets (four) 0.1294, a delay (three) 0.1320. The offsets cut 7 % of what the friction cuts, the delay under
+    1 %: neither is the leaner partner a joint refit is spent on (LEANER_MIN_SHARE, a quarter). At a share of 5 %
+    the offsets would be."""
+    order = ["cubic + friction", "cubic + loop", "cubic + offsets", "cubic + delay"]
+    sizes = {"cubic + friction": 5, "cubic + loop": 9, "cubic + offsets": 4, "cubic + delay": 3}
+    cuts = {n: 0.1323 - v for n, v in zip(order, (0.0908, 0.1033, 0.1294, 0.1320))}
+    assert selection.leaner_best(order, sizes, cuts) == []
+    assert selection.leaner_best(order, sizes, cuts, min_share=0.05) == ["cubic + offsets"]
 
 
 def test_a_rough_loop_behind_a_leaner_partner_beside_a_model_is_refitted_jointly_too():

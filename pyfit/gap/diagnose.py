@@ -249,17 +249,18 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     `cfg.min_partner_explained` of that residual: the path ends there, and so does the search unless that model
     holds a free-shape loop whose misfit is still above the noise, a possible stand-in). Each partner is refitted
     beside the model so far held at its own refit (attribute.pinned); the one that helps most there, the best of
-    those with fewer parameters than it (selection.leaner_best: a free-shape loop absorbs most beside a held
-    model), and the one that helps least (the control), are then refitted jointly (from each member's own refit,
-    the effects' starts, the partner's refit beside the model and the members refitted beside the partner's
-    refit; a combination reached from two paths is refitted beside each path's model, the better kept, and its
-    joint refit probes from its own path's refit beside too). Go on from the best combination (the lowest misfit;
-    of two within the noise, the one with fewer parameters) when it removes `min_excess_cut` of the misfit above
-    the floor that the model it extends leaves once refitted on with a combination's budget (the combinations
-    start from that refit and never end worse than it) or, when lower, the misfit of the control's joint refit
-    (what the combination's extra evaluations alone buy the model it extends, counted with the control's partner
-    at zero: selection.budget_control), up to `cfg.max_effects` members. Where the control at zero fits the
-    held-out files better than the model it extends, that model is refitted on from there (and takes the fit
+    those with fewer parameters than it that cuts a quarter of its cut there (selection.leaner_best: a free-shape
+    loop absorbs most beside a held model), and the one that helps least (the control), are then refitted
+    jointly (from each member's own refit, the effects' starts, the partner's refit beside the model and the
+    members refitted beside the partner's refit; a combination reached from two paths is refitted beside each path's
+    model, the better kept, and its joint refit probes from its own path's refit beside too). Go on from the best
+    combination (the lowest misfit; of two within the noise, the one with fewer parameters) when it removes
+    `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted on with a
+    combination's budget (the combinations start from that refit and never end worse than it) or, when lower, the
+    misfit of the control's joint refit (what the combination's extra evaluations alone buy the model it extends,
+    counted with the control's partner at zero: selection.budget_control), up to `cfg.max_effects` members. Where
+    the control at zero fits the held-out files better than the model it extends, that model is refitted on from
+    there (and takes the fit
     when it fits the calibration files better): the longer fit the control stands for.
     The noise these tests measure a misfit above is the floor should the sensor noise grow with the level
     (gap["noise_floor_scaled"]): a floor taken too low asks a right pair to remove half of a misfit that is noise.
@@ -388,9 +389,11 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             joint = {order[0], order[-1]} if len(names) >= selection.CONTROL_SIBLINGS else set(order[:1])
             # a partner with many free parameters (a free-shape loop) absorbs more beside a held model than one
             # with few, whose member held at a refit that made up for it holds it back (a cubic spring stiffened
-            # less, a viscous damper raised for a quadratic one): the best of the leaner ones is refitted jointly too
+            # less, a viscous damper raised for a quadratic one): the best of the leaner ones is refitted jointly too,
+            # when it cuts a quarter of what the leader cuts beside the model (selection.LEANER_MIN_SHARE)
             sizes = {n: len(effects[n].params) for n in order}
-            joint |= set(selection.leaner_best(order, sizes))
+            cuts = {n: fits[current].calibration_nrmse - beside[n].calibration_nrmse for n in order}
+            joint |= set(selection.leaner_best(order, sizes, cuts))
             # and a free-shape loop without basins (the damper's) refitted beside from its one best start only: a
             # rough estimate, which a leaner partner can lead taking up the loop's dissipation (friction beside a
             # cubic spring held at its own refit): the best such richer partner is refitted jointly too
@@ -683,6 +686,11 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         task = nominal_task(system, fmu, cal, cfg.nominal_budget, cfg.upsample,
                             threads=workers or os.cpu_count() or 1)
         nominal = _fit_and_store((task, out / "fits" / "nominal.json", key))
+    # from here on a simulation that takes SLOW_FACTOR times the calibrated nominal's on the same record counts as
+    # failed (a stiff parameter set the integrator crawls through: sim.with_time_limits)
+    limited = {r.name: r for r in sim.with_time_limits(runner, records, nominal.params, cfg.upsample,
+                                                       system.lead_periods)}
+    records, cal, held = ([limited[r.name] for r in rs] for rs in (records, cal, held))
     clock.end("nominal calibration")
     deflections = []
     for r in cal:

@@ -4,6 +4,7 @@ periods are simulated in front of it and dropped. A failed or diverging run retu
 from __future__ import annotations
 
 import functools
+import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -16,6 +17,17 @@ from pyfit.runtime.drive import drive
 
 
 SENSOR_DELAY = "sensor_delay"  # candidate parameter [s]: the outputs lag the inputs by it (channel skew)
+
+# wall-clock limit of one simulation in a diagnosis [s]: a record simulates in well under a second to a few
+# seconds; a parameter set so stiff that the integrator crawls (a friction smoothed over a tiny velocity beside a
+# hard spring) counts as failed, as a diverging one does, instead of holding a fit for hours
+MAX_WALL_S = 60.0
+# ... and, once the nominal is calibrated, SLOW_FACTOR times that nominal's simulation of the same record (at least
+# MIN_WALL_S, at most MAX_WALL_S): the fits of the effects named in the stored campaigns took at most 6.2 times
+# the nominal's time per evaluation, while a stiff loop's evaluations ran into the 60 s limit (6,700 times it on
+# damper calibration campaign case 78, where 6 of 141 simulations took 335 of the 336 s)
+SLOW_FACTOR = 50.0
+MIN_WALL_S = 0.5
 
 
 @dataclass
@@ -35,6 +47,8 @@ class Record:
     support: tuple = ()  # (displacement, velocity) inputs of a support motion whose displacement was integrated:
     # the model is simulated from rest relative to that support (simulate)
     smooth_inputs: bool = False  # the FMU is driven by the inputs' cubic spline (pyfit.runtime.drive)
+    max_wall_s: float = MAX_WALL_S  # a simulation of it still running after this many seconds [s] counts as failed
+    # (a diagnosis sets it from the calibrated nominal's own simulation time: with_time_limits)
 
     def compared(self, name: str) -> np.ndarray:
         """An input over the samples that are compared (from `first` on)."""
@@ -115,10 +129,6 @@ TOLERANCE = 1e-6
 # stay within 2e-4 of their RMS of a run at 1e-9 at 16 times the sensor rate (tests/test_spline_drive.py), for
 # less than a 1e-6 run costs on the damper (bench/input_order.py)
 SPLINE_TOLERANCE = 1e-5
-# wall-clock limit of one simulation in a diagnosis [s]: a record simulates in well under a second to a few
-# seconds; a parameter set so stiff that the integrator crawls (a friction smoothed over a tiny velocity beside a
-# hard spring) counts as failed, as a diverging one does, instead of holding a fit for hours
-MAX_WALL_S = 60.0
 
 
 def tolerance_of(rec: Record) -> float:
@@ -149,12 +159,28 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
         repeat = rec.n // rec.samples_per_period
         inputs = {k: v.reshape(repeat, rec.samples_per_period).mean(axis=0) for k, v in rec.inputs.items()}
     res = drive(runner, inputs, rec.fs, list(outputs or rec.outputs), params, upsample, rec.samples_per_period,
-                max(lead_periods, 1) if rec.periodic else 0, tolerance, MAX_WALL_S, rec.smooth_inputs)
+                max(lead_periods, 1) if rec.periodic else 0, tolerance, rec.max_wall_s, rec.smooth_inputs)
     if not res.ok:
         return None
     values = res.values if rigid is None else {k: _moved_back(runner, k, v, *rigid) for k, v in res.values.items()}
     return {k: without_offset(delayed(np.tile(v, repeat), rec.fs, delay, rec.periodic)[rec.first:])
             for k, v in values.items()}
+
+
+def with_time_limits(runner: FmuRunner, records: list[Record], params: dict, upsample: int = 4,
+                     lead_periods: int = 1, repeats: int = 3) -> list[Record]:
+    """The records, each with max_wall_s set to SLOW_FACTOR times its simulation's wall time at `params` (the
+    fastest of `repeats` runs), within [MIN_WALL_S, MAX_WALL_S] [s]: a parameter set whose simulation takes that
+    much longer than the calibrated nominal's crawls through a stiff integration and counts as failed."""
+    limited = []
+    for rec in records:
+        took = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            simulate(runner, rec, params, upsample, lead_periods)
+            took.append(time.perf_counter() - t0)
+        limited.append(replace(rec, max_wall_s=min(MAX_WALL_S, max(MIN_WALL_S, SLOW_FACTOR * min(took)))))
+    return limited
 
 
 def _moved_back(runner: FmuRunner, name: str, values: np.ndarray, x_rigid: np.ndarray, v_rigid: float

@@ -323,10 +323,12 @@ def _cubic_starts(*names):
 
 
 # a lag of the output channels behind the inputs (unsynchronised DAQ modules, different anti-alias filters):
-# up to half a radian at the data's dominant frequency (sigma_y / sigma_v ~ 1/ω), either sign
+# up to half a radian at the data's dominant frequency (sigma_y / sigma_v ~ 1/ω), either sign. Linear: within the
+# noise threshold its refit takes up the group delay of the lab's anti-alias filters as well
 SENSOR_DELAY = Effect(
     "sensor_delay", (Param("sensor_delay", _sym(lambda s: 0.5 * s.sigma_y / s.sigma_v)),),
-    signature="a phase error that grows in proportion to frequency, the same at every level", signal_only=True)
+    signature="a phase error that grows in proportion to frequency, the same at every level", signal_only=True,
+    linear=True)
 
 SDOF_EFFECTS = {
     "hysteresis": Effect(
