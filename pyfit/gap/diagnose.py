@@ -260,8 +260,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     misfit of the control's joint refit (what the combination's extra evaluations alone buy the model it extends,
     counted with the control's partner at zero: selection.budget_control), up to `cfg.max_effects` members. Where
     the control at zero fits the held-out files better than the model it extends, that model is refitted on from
-    there (and takes the fit
-    when it fits the calibration files better): the longer fit the control stands for.
+    there (and takes the fit when it fits the calibration files better): the longer fit the control stands for.
     The noise these tests measure a misfit above is the floor should the sensor noise grow with the level
     (gap["noise_floor_scaled"]): a floor taken too low asks a right pair to remove half of a misfit that is noise.
     A path's end is checked backward: the model without its last-added member is refitted from the end's
