@@ -102,7 +102,7 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0, smoo
         if not recorded:
             raise ValueError(f"{m.path.with_suffix('.toml')}: [inputs] needs the motion as one of "
                              f"{', '.join(motion)} (model_variable), in m, mm, m/s, m/s2 or g")
-        band = kinematics.excited_band(next(iter(recorded.values())), m.sample_rate_hz)
+        band = kinematics.excited_band(next(iter(recorded.values())), m.sample_rate_hz, samples_per_period=spp)
         full = kinematics.complete(recorded, m.sample_rate_hz, band, periodic=bool(spp))
         derived = tuple(var for kind, var in zip("xva", motion) if var not in inputs)
         inputs = {**inputs, **{var: full[kind] for kind, var in zip("xva", motion)}}
