@@ -27,15 +27,20 @@ def _far_geometry():
     raise AssertionError("no catalogue damper in 100 draws has its default-EI resonances outside its band")
 
 
+def _calibrated_nominal(data, out, fmu_dir, described: dict) -> dict:
+    """The diagnosis report of `data` with the damper described by `described`: the nominal calibration is what is
+    checked, so the nominal's test alone decides (no refits of the effects)."""
+    return diagnose("damper", data, out, DiagnoseConfig(refit_within_noise=False), fmu_dir, workers=1,
+                    progress=False, nominal=NominalModel("damper", described))
+
+
 def test_a_nominal_with_every_resonance_outside_the_band_is_calibrated_from_the_measured_peaks(
         tmp_path, fmu_dir, measured):
     geometry, described, band = _far_geometry()
     family = dataclasses.replace(datasets.DAMPER, band_hz=band)
     data = datasets.write_dataset(tmp_path / "data", family, "none", seed=11, periods=2, base=geometry,
                                   style=datasets.LabStyle("noise", ("acc_x1", "acc_x2"), "xva", record_s=6.0))
-    # the nominal calibration is what is checked: the nominal's test alone decides (no refits of the effects)
-    rep = diagnose("damper", data, tmp_path / "diagnosis", DiagnoseConfig(refit_within_noise=False), fmu_dir,
-                   workers=1, progress=False, nominal=NominalModel("damper", described))
+    rep = _calibrated_nominal(data, tmp_path / "diagnosis", fmu_dir, described)
     assert rep["verdict"] == "no significant gap"
     # EI sets every resonance (f ∝ √EI); the nominal fit of these noise records resolves it to about 1e-5:
     # 0.2 % of EI (0.1 % of frequency) leaves room for other noise seeds, not for a start left at the default
@@ -55,8 +60,7 @@ def test_a_start_with_the_right_stiffness_but_damping_far_off_is_not_lost_to_a_s
                                   base=case.base, style=datasets.LabStyle(case.excitation, tuple(case.outputs),
                                                                           case.motion, record_s=6.0))
     described = {k: v for k, v in case.base.items() if k not in FAMILY["damper"].linear}
-    rep = diagnose("damper", data, tmp_path / "diagnosis", DiagnoseConfig(refit_within_noise=False), fmu_dir,
-                   workers=1, progress=False, nominal=NominalModel("damper", described))
+    rep = _calibrated_nominal(data, tmp_path / "diagnosis", fmu_dir, described)
     assert rep["verdict"] == "no significant gap"
     # measured: 1.5e-5 (EI) and 5e-4 (alpha_pd, which the noise resolves less well than the stiffness)
     measured("heavily damped damper on noise records, a wrong-EI start misfitting least: |calibrated EI / true "

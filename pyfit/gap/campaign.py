@@ -352,19 +352,16 @@ def _share(part: int, whole: int) -> str:
     return "—" if not whole else f"{100 * part / whole:.0f} %"
 
 
-def _count(n: int, noun: str) -> str:
-    return f"{n} {noun}" + ("" if n == 1 else "s")
-
-
 def markdown(s: dict) -> str:
     """The campaign summary as Markdown."""
     system = {"sdof": "SDOF", "damper": "damper (random geometry)"}[s.get("model", "sdof")]
+    diagnosed = s["cases"] - s.get("resumed", 0)  # by this run
     lines = [f"{s['cases']} {system} cases (seed {s['seed']}, records {s['record_s']:g} s), {s['where']}: wall "
              f"{s['wall_s'] / 60:.1f} min"
-             + (f" for the {_count(s['cases'] - s['resumed'], 'case')} this run diagnosed ({s['resumed']} read from an "
-                "earlier run" + (f", whose runs took {s['earlier_wall_s'] / 60:.1f} min: a full run takes at most "
-                                 f"{(s['wall_s'] + s['earlier_wall_s']) / 60:.1f} min" if s.get("earlier_wall_s")
-                                 else "") + ")" if s.get("resumed") else "")
+             + (f" for the {diagnosed} case{'' if diagnosed == 1 else 's'} this run diagnosed ({s['resumed']} read "
+                "from an earlier run" + (f", whose runs took {s['earlier_wall_s'] / 60:.1f} min: a full run takes "
+                                         f"at most {(s['wall_s'] + s['earlier_wall_s']) / 60:.1f} min"
+                                         if s.get("earlier_wall_s") else "") + ")" if s.get("resumed") else "")
              + f", median {s['median_case_s']:.0f} s per case (writing the files and "
              f"diagnosing); command: `{s['command']}`.", "",
              f"Top-1 accuracy on the {s['effect_cases']} cases with a withheld effect: {100 * s['top1']:.0f} %; "
