@@ -106,3 +106,33 @@ def test_a_pair_with_a_loop_descends_from_each_loop_basin_and_so_does_the_loop_b
                    {n: (-10.0, 10.0) for n in ("k", "alpha", "k3", *shape)}, pair.name, 2, 120, 1, basin=pair.basin)
     assert pinned(task, {"k3": 1e8}, 60).basin is sdof_loop_basin
     assert pinned(task, {"alpha": 1e4, **shape}, 60).basin is None
+
+
+def test_a_diagnosis_runs_its_linear_algebra_on_one_blas_thread(tmp_path, monkeypatch):
+    """A multi-threaded BLAS rounds by its thread count and a multistart least squares amplifies that into another
+    path: a diagnosis holds every BLAS library on one thread (as a Dask worker starts), whatever the caller set."""
+    import threadpoolctl
+
+    seen = []
+
+    def probe(*args, **kwargs):  # the first step of a diagnosis after the FMU is loaded: record and stop there
+        seen.extend(i["num_threads"] for i in threadpoolctl.threadpool_info() if i["user_api"] == "blas")
+        raise RuntimeError("stopped by the test")
+
+    monkeypatch.setattr(dg, "make_system", probe)
+    monkeypatch.setattr(dg, "ensure_fmu", lambda name, where: "unused.fmu")
+    monkeypatch.setattr(dg, "FmuRunner", lambda fmu: None)
+    monkeypatch.setattr(dg, "fmu_defaults", lambda runner: {})
+    with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        with pytest.raises(RuntimeError, match="stopped by the test"):
+            dg.diagnose("sdof", tmp_path, tmp_path / "out", progress=False)
+        after = [i["num_threads"] for i in threadpoolctl.threadpool_info() if i["user_api"] == "blas"]
+    assert seen and set(seen) == {1}
+    assert set(after) == {2}  # the caller's setting is back once the diagnosis returns
+    # and so does each fit a diagnosis runs in a worker process, which starts with the machine's default
+    monkeypatch.setattr(dg, "run_fit", probe)
+    seen.clear()
+    with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        with pytest.raises(RuntimeError, match="stopped by the test"):
+            dg._fit_and_store((None, tmp_path / "fit.json", "key", "a stage"))
+    assert seen and set(seen) == {1}

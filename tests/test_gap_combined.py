@@ -194,6 +194,18 @@ def test_a_one_parameter_partner_that_a_loop_outdoes_beside_the_first_member_is_
              0.05)
 
 
+def test_a_lean_pair_whose_descent_stalls_is_not_lost_to_a_loop_pair(tmp_path, fmu_dir, measured):
+    """Coulomb friction and quadratic damping under sweeps recorded as displacement (a case of the campaign's draw,
+    CasADi reference): the pair's joint refit stalls (near-ideal friction) above the friction with a free-shape
+    loop, which then fit the held-out files better; refitted on before the step is judged, the true pair fits them
+    best and is named, with c2 recovered."""
+    case, best = _campaign_case_named(tmp_path, fmu_dir, 18, 44, "coulomb_friction+quadratic_damping", "sweep")
+    # measured 0.09 (its refit on stops there too, above the truth's held-out misfit): room for 1.5x that
+    measured("SDOF with Coulomb friction and quadratic damping on sweeps, a loop pair fitting better before the "
+             "pair's refit on: fitted c2 relative to the withheld value",
+             abs(best["params"]["c2"] / case.truth["c2"] - 1), 0.15)
+
+
 def test_a_loop_standing_in_for_a_spring_beyond_its_own_sensitivity_leaves_the_spring_path_its_try(
         tmp_path, fmu_dir, measured):
     """A hardening spring and a weak loop under multisines recorded as displacement (a case of the campaign's draw,
@@ -215,6 +227,18 @@ def test_a_damper_loop_standing_in_for_hardening_springs_leaves_the_springs_path
     case, best = _campaign_case_named(tmp_path, fmu_dir, 0, 2, "cubic_stiffness+hysteresis", "multisine", "damper")
     measured("damper with hardening springs and a loop standing in for them: fitted k_cs2 relative to the withheld "
              "value", abs(best["params"]["k_cs2"] / case.truth["k_cs2"] - 1), 0.1)
+
+
+def test_a_pair_whose_joint_refit_failed_on_the_loop_path_is_refitted_again_on_the_springs_path(
+        tmp_path, fmu_dir, measured):
+    """Hardening cubic springs and a loop of a random damper geometry under multisines recorded as clamp force and
+    one mass's acceleration (a case of the damper campaign's draw, CasADi reference): the loop refitted alone
+    leads and stands in for the springs, and the pair's joint refit on the loop's path adds nothing to it; the
+    springs' path refits the pair again from the springs' refit, names it and recovers the springs' stiffness."""
+    case, best = _campaign_case_named(tmp_path, fmu_dir, 1, 99, "cubic_stiffness+hysteresis", "multisine", "damper")
+    # measured 0.003: the springs set the resonance shift the records resolve well above the noise
+    measured("damper with hardening springs and a loop whose pair refit on the loop's path added nothing: fitted "
+             "k_cs2 relative to the withheld value", abs(best["params"]["k_cs2"] / case.truth["k_cs2"] - 1), 0.03)
 
 
 def test_a_loop_beside_a_held_quadratic_damping_is_refitted_from_each_of_its_basins(tmp_path, fmu_dir, measured):

@@ -133,6 +133,22 @@ def test_a_rough_loop_behind_a_leaner_partner_beside_a_model_is_refitted_jointly
     assert selection.richer_best([], {}, set()) == []
 
 
+def test_a_lean_pair_that_a_loop_pair_outdoes_is_refitted_on_before_the_step_is_judged():
+    """Held-out misfits of one step's joint refits from the friction's refit, campaign seed 18 case 44 (Coulomb
+    friction and quadratic damping withheld, sweeps read as displacement): friction with a free-shape loop leaves
+    0.0125, with the true quadratic damping 0.0218 (its descent stalled), with a delay 0.0350 (the control). The
+    quadratic pair is the rival refitted on; never the control (then the next lean pair is), and none when the
+    loop pair is not better or when no pair holds a loop."""
+    after = {"c + loop": 0.0125, "c + quadratic": 0.0218, "c + delay": 0.0350}
+    joint = list(after)
+    assert selection.lean_rival(joint, {"c + loop"}, after, "c + delay") == "c + quadratic"
+    assert selection.lean_rival(joint, {"c + loop"}, after, "c + quadratic") == "c + delay"
+    assert selection.lean_rival(joint[:2], {"c + loop"}, after, "c + quadratic") is None
+    assert selection.lean_rival(joint, {"c + loop"}, {**after, "c + loop": 0.0300}, "c + delay") is None
+    assert selection.lean_rival(joint, set(), after, "c + delay") is None
+    assert selection.lean_rival(["c + loop"], {"c + loop"}, after, None) is None
+
+
 def test_a_model_that_explains_the_data_with_nothing_a_candidate_explains_left_is_not_extended():
     """The screening repeated at the model so far (fractions of its calibration residual), with numbers of the
     diagnoses that found them. Lab sweeps of the family's hysteresis (accelerometer files, floor estimate 0.0036):

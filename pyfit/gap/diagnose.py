@@ -12,6 +12,7 @@ import functools
 import itertools
 from dataclasses import asdict, dataclass, fields
 
+import threadpoolctl
 
 from pyfit.runtime.batch import map_tasks
 from pyfit.runtime.clock import StageClock
@@ -160,6 +161,19 @@ def _simulated(runner, records, values: dict, system, cfg: DiagnoseConfig) -> di
     return {r.name: sim.simulate(runner, r, values, cfg.upsample, system.lead_periods) for r in records}
 
 
+def _on_one_blas_thread(func):
+    """`func` run with the BLAS libraries on one thread (threadpoolctl): a multi-threaded BLAS rounds by its thread
+    count, and a multistart least squares amplifies a last-digit difference into another path, so the same files
+    gave another verdict diagnosed alone than on a Dask worker (which starts with one BLAS thread). A diagnosis
+    and each fit it runs in a worker process hold to it."""
+    @functools.wraps(func)
+    def run(*args, **kwargs):
+        with threadpoolctl.threadpool_limits(limits=1, user_api="blas"):
+            return func(*args, **kwargs)
+    return run
+
+
+@_on_one_blas_thread
 def _fit_and_store(job) -> Fit:
     """Run one fit (in a worker) and store it at once, so an interrupted diagnosis keeps it. A job may carry
     stages: fits run first, whose results the fit then also starts from (their evaluations and wall time are
@@ -253,12 +267,15 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     loop absorbs most beside a held model), and the one that helps least (the control), are then refitted
     jointly (from each member's own refit, the effects' starts, the partner's refit beside the model and the
     members refitted beside the partner's refit; a combination reached from two paths is refitted beside each path's
-    model, the better kept, and its joint refit probes from its own path's refit beside too). Go on from the best
-    combination (the lowest misfit; of two within the noise, the one with fewer parameters) when it removes
-    `min_excess_cut` of the misfit above the floor that the model it extends leaves once refitted on with a
-    combination's budget (the combinations start from that refit and never end worse than it) or, when lower, the
-    misfit of the control's joint refit (what the combination's extra evaluations alone buy the model it extends,
-    counted with the control's partner at zero: selection.budget_control), up to `cfg.max_effects` members. Where
+    model, the better kept, and its joint refit probes from its own path's refit beside too; a pair refitted
+    jointly on its partner's path, where it added too little, is refitted jointly again from this path's starts
+    (rejoined below); the best joint refit without a free-shape loop is refitted on when one with a loop fits
+    better: selection.lean_rival). Go on from the best combination (the lowest misfit; of two within the noise,
+    the one with fewer parameters) when it removes `min_excess_cut` of the misfit above the floor that the model
+    it extends leaves once refitted on with a combination's budget (the combinations start from that refit and
+    never end worse than it) or, when lower, the misfit of the control's joint refit (what the combination's
+    extra evaluations alone buy the model it extends, counted with the control's partner at zero:
+    selection.budget_control), up to `cfg.max_effects` members. Where
     the control at zero fits the held-out files better than the model it extends, that model is refitted on from
     there (and takes the fit when it fits the calibration files better): the longer fit the control stands for.
     The noise these tests measure a misfit above is the floor should the sensor noise grow with the level
@@ -278,13 +295,13 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     from each, a weak loop's among them). Of the ends of
     these paths, a larger model is selected only by the same rule, and of two as large whose misfits are both
     within the noise, the one with fewer parameters (selection.simpler_or_better). When then no single effect
-    and not the model selected meets the absolute criterion, the `cfg.grid_models` models with the lowest
-    held-out misfit are each refitted from the best point of a grid over their members' strengths
-    (systems.strength_grid; a pair's valley where a descent from its members' refits stops short), and the
-    selection is made again with them. When still nothing meets it and the calibration records are not periodic
+    and not the model selected meets the absolute criterion and the calibration records are not periodic
     (sweeps, stepped sines, noise), the single effects and pairs of the best of them are fitted to the amplitude
     envelopes first and refitted on the waveforms from there (enveloped, below), and the selection weighs those
-    pairs too. Adds the fits and held-out
+    pairs too. When still nothing meets it, the `cfg.grid_models` models with the lowest held-out misfit are
+    each refitted from the best point of a grid over their members' strengths (systems.strength_grid; a pair's
+    valley where a descent from its members' refits stops short), and the selection is made again with them (the
+    envelopes go first: a few fits, where the grid simulates hundreds of points). Adds the fits and held-out
     simulations to `fits` and `sims`; returns the system with the combined effects among its effects and the
     model selected (None when nothing was tried)."""
     before, floor = gap["overall"], gap["noise_floor"]
@@ -346,13 +363,12 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                                         cfg.min_partner_explained):
                 settled.add(current)  # it explains the data and no candidate explains what is left: done
                 break
+            again = []  # pairs refitted jointly on the partner's path that added too little there: rejoined
             for partner in sorted(others, key=lambda n: -explained[n])[:cfg.partners]:
                 together = frozenset(members + [partner])
-                if together in named and named[together] not in beside_only:  # refitted jointly on another path
-                    names.append(named[together])
-                    continue
                 # new, or reached from another path that held only its other member(s) at their refit: refitted
-                # beside this path's model too (a weak loop beside a strong spring is found beside the spring)
+                # beside this path's model too (a weak loop beside a strong spring is found beside the spring);
+                # one refitted jointly on the partner's path is refitted again only when it added too little there
                 combo = effects[named[together]] if together in named else combine(
                     [system.effects[m] for m in members + [partner]])
                 effects[combo.name], named[together] = combo, combo.name
@@ -372,7 +388,13 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 # from the same starts lets the weak one take over the strong one's part
                 so_far = {n: v for n, v in fits[current].params.items()
                           if n in task.start and n not in added and n not in system.linear}
-                new.append((combo.name, task, so_far, {n: fits[partner].params[n] for n in added}))
+                tried_here = (combo.name, task, so_far, {n: fits[partner].params[n] for n in added})
+                if combo.name not in fits or combo.name in beside_only:
+                    new.append(tried_here)
+                elif len(together) == 2 and not selection.adds_enough(after[partner], after[combo.name], above,
+                                                                      cfg.min_excess_cut):
+                    again.append(tried_here)  # refitted jointly on the partner's path, adding too little there
+            rejoined(current, again)
             # every partner first beside the model so far held (half a refit's budget, no probes); the joint
             # refit then only for the partner that helps most there and, as the control, the one that helps least
             beside = _fits_of([(pinned(task, so_far, cfg.refit_budget // 2),
@@ -419,8 +441,15 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             for name in names:
                 if name not in after or name not in sims:
                     simulated(name)
-            best = functools.reduce(kept, names) if names else None  # the lowest misfit, or the leanest at the noise
             least = order[-1] if order else None
+            # a free-shape loop can take up part of any effect: the best jointly refitted pair without one, when a
+            # pair with one fits the held-out files better, is first refitted on with a path end's polish budget
+            rival = selection.lean_rival(
+                jointly, {n for n in jointly if any(system.effects[m].free_shape for m in effects[n].members)},
+                after, least)
+            if rival is not None:
+                onward(rival, fits[rival].params, 2 * cfg.refit_budget, f"{_stem(rival)}.against_loop")
+            best = functools.reduce(kept, names) if names else None  # the lowest misfit, or the leanest at the noise
             tried = {n: (task, side) for n, task, _, side in new}
             at_zero = without_partner(least, *tried[least]) if least not in (None, best) else float("inf")
             if at_zero < after[current]:
@@ -438,6 +467,27 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 break
             current = best
         return pruned(current)
+
+    def rejoined(current, again):
+        # each pair refitted jointly on its partner's path where it added too little (`again`: as `new` in grow),
+        # refitted beside the model `current` held (half a refit's budget) and jointly from this path's starts and
+        # that refit (stored as fits/<pair>.on.<current>.json); its fit replaced when that fits the calibration
+        # files better. From a loop's path the loop can stand in for the other member in the joint refit too;
+        # from the other member's own refit the loop explains only what that member leaves
+        beside = _fits_of([(pinned(task, so_far, cfg.refit_budget // 2),
+                            out / "fits" / f"{_stem(n)}.beside.{_stem(current)}.json")
+                           for n, task, so_far, _ in again], key, alone, workers, progress, "pairs again beside")
+        jobs = [(dataclasses.replace(task, alternatives=task.alternatives + ({n: beside[name].params[n]
+                                                                             for n in task.start},),
+                                     probed=({n: beside[name].params[n] for n in task.start},)),
+                 out / "fits" / f"{_stem(name)}.on.{_stem(current)}.json", pinned(task, side, cfg.refit_budget // 2))
+                for name, task, _, side in again]
+        for name, fit in _fits_of(jobs, key, alone, workers, progress, "pairs again").items():
+            if fit.calibration_nrmse < fits[name].calibration_nrmse:  # its cost includes both refits
+                fits[name] = dataclasses.replace(fit, evaluations=fit.evaluations + beside[name].evaluations
+                                                 + fits[name].evaluations, wall_s=fit.wall_s + beside[name].wall_s
+                                                 + fits[name].wall_s)
+                simulated(name)
 
     def onward(name, values, budget, stored_as, grid=()):
         # the model `name` refitted from `values` (or the best of `grid`, points overriding them), with `budget`
@@ -571,7 +621,15 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         # of its sensitivity to the spring, where the path from the spring finds the weak loop beside it)
     selected = functools.reduce(kept, ends)
     singles = [n for n in fits if not effects[n].members]
-    if all(after[n] > explained_below for n in singles + [selected]):
+
+    def unexplained():  # no single effect and not the model selected meets the absolute criterion
+        return all(after[n] > explained_below for n in singles + [selected])
+
+    if unexplained() and not any(r.periodic for r in cal):
+        # sweeps, stepped sines, noise: the amplitude envelopes first (a few fits; the grid below simulates
+        # hundreds of points, stiff ones crawling to their time limit)
+        selected = functools.reduce(kept, [selected] + enveloped(singles))
+    if unexplained():
         # nothing explains the data: the best models, each refitted from the best point of a grid over its
         # members' strengths (its other parameters at its refit); then selected again among the paths' ends
         gridded = sorted(after, key=after.get)[:cfg.grid_models]
@@ -579,9 +637,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             members = [system.effects[m] for m in effects[name].members or (name,)]
             onward(name, fits[name].params, cfg.refit_budget, f"{_stem(name)}.gridded",
                    strength_grid(members, scale, fits[name].params))
-        selected = functools.reduce(kept, ends + [n for n in gridded if n not in ends])
-    if all(after[n] > explained_below for n in singles + [selected]) and not any(r.periodic for r in cal):
-        selected = functools.reduce(kept, [selected] + enveloped(singles))
+        selected = functools.reduce(kept, list(dict.fromkeys([selected] + ends + gridded)))
     return dataclasses.replace(system, effects=effects), selected
 
 
@@ -622,6 +678,7 @@ def _with_user_candidates(system, users, fmu_parameters: set):
     return dataclasses.replace(system, effects={**system.effects, **users.effects})
 
 
+@_on_one_blas_thread
 def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, fmu_dir="fmus",
              workers: int | None = None, progress: bool = True, nominal: NominalModel | str | None = None,
              candidates=None) -> dict:

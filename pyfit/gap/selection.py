@@ -122,6 +122,20 @@ def richer_best(order: list[str], sizes: dict[str, int], among: set[str]) -> lis
     return [n for n in order if n in among and sizes[n] > sizes[order[0]]][:1] if order else []
 
 
+def lean_rival(joint, loops: set, after: dict, control) -> str | None:
+    """Of one selection step's jointly refitted models (`joint`), the one not among `loops` (those with a
+    free-shape loop) with the lowest held-out misfit (`after`), when a model among `loops` fits the held-out files
+    better; None otherwise, and never the step's control (`control`: its refit stands for what evaluations alone
+    buy). A loop of free shape can take up part of any effect, and the descent of a lean pair whose friction is
+    near-ideal (a steep tanh) can stall short of its floor where the loop's many starts do not: that rival is
+    refitted on before the step's best is chosen."""
+    lean = [n for n in joint if n not in loops and n != control]
+    if not lean or not any(n in loops for n in joint):
+        return None
+    rival = min(lean, key=after.__getitem__)
+    return rival if min(after[n] for n in joint if n in loops) < after[rival] else None
+
+
 def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, min_excess_cut: float,
                       control: float = float("inf"), parameters: tuple[int, int] = (0, 0),
                       noise: float = 0.0) -> int:
