@@ -397,9 +397,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             rejoined(current, again)
             # every partner first beside the model so far held (half a refit's budget, no probes); the joint
             # refit then only for the partner that helps most there and, as the control, the one that helps least
-            beside = _fits_of([(pinned(task, so_far, cfg.refit_budget // 2),
-                                out / "fits" / f"{_stem(n)}.beside.{_stem(current)}.json")
-                               for n, task, so_far, _ in new], key, alone, workers, progress, "partners beside")
+            beside = beside_refits(new, current, "partners beside")
             own = dict(beside)  # the refits beside this path's model (a joint refit starts from them too)
             for name, fit in own.items():  # a refit beside another path's model stays when it fits better
                 if name in fits and fits[name].calibration_nrmse <= fit.calibration_nrmse:
@@ -428,11 +426,9 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                 beside_only.add(name)
             # (from the best refit beside a path's model among its starts, and probed from this path's own: a weak
             # loop beside a strong spring's refit misfits more than a loop standing in for the spring)
-            jointly = _fits_of([(dataclasses.replace(
-                task, alternatives=task.alternatives + ({n: beside[name].params[n] for n in task.start},),
-                probed=({n: own[name].params[n] for n in task.start},)), out / "fits" / f"{_stem(name)}.json",
-                pinned(task, side, cfg.refit_budget // 2)) for name, task, _, side in new if name in joint],
-                key, alone, workers, progress, "combinations")
+            jointly = _fits_of([joint_job(task, side, beside[name], own[name], _stem(name))
+                                for name, task, _, side in new if name in joint],
+                               key, alone, workers, progress, "combinations")
             for name, fit in jointly.items():  # its cost includes the refit beside the model so far
                 fits[name] = dataclasses.replace(fit, evaluations=fit.evaluations + beside[name].evaluations,
                                                  wall_s=fit.wall_s + beside[name].wall_s)
@@ -468,19 +464,28 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             current = best
         return pruned(current)
 
+    def beside_refits(tried, current, desc):
+        # each combination of `tried` (name, task, the model's values held, the partner's own) refitted beside the
+        # model `current` held at those values (half a refit's budget), stored as fits/<name>.beside.<current>.json
+        return _fits_of([(pinned(task, so_far, cfg.refit_budget // 2),
+                          out / "fits" / f"{_stem(n)}.beside.{_stem(current)}.json")
+                         for n, task, so_far, _ in tried], key, alone, workers, progress, desc)
+
+    def joint_job(task, side, start: Fit, probe: Fit, stored_as):
+        # a combination's joint refit (a _fit_and_store job) that also starts from `start`'s values and probes
+        # from `probe`'s, after its members refitted beside the partner's own values (`side`) as a stage
+        return (dataclasses.replace(task, alternatives=task.alternatives + ({n: start.params[n] for n in task.start},),
+                                    probed=({n: probe.params[n] for n in task.start},)),
+                out / "fits" / f"{stored_as}.json", pinned(task, side, cfg.refit_budget // 2))
+
     def rejoined(current, again):
         # each pair refitted jointly on its partner's path where it added too little (`again`: as `new` in grow),
         # refitted beside the model `current` held (half a refit's budget) and jointly from this path's starts and
         # that refit (stored as fits/<pair>.on.<current>.json); its fit replaced when that fits the calibration
         # files better. From a loop's path the loop can stand in for the other member in the joint refit too;
         # from the other member's own refit the loop explains only what that member leaves
-        beside = _fits_of([(pinned(task, so_far, cfg.refit_budget // 2),
-                            out / "fits" / f"{_stem(n)}.beside.{_stem(current)}.json")
-                           for n, task, so_far, _ in again], key, alone, workers, progress, "pairs again beside")
-        jobs = [(dataclasses.replace(task, alternatives=task.alternatives + ({n: beside[name].params[n]
-                                                                             for n in task.start},),
-                                     probed=({n: beside[name].params[n] for n in task.start},)),
-                 out / "fits" / f"{_stem(name)}.on.{_stem(current)}.json", pinned(task, side, cfg.refit_budget // 2))
+        beside = beside_refits(again, current, "pairs again beside")
+        jobs = [joint_job(task, side, beside[name], beside[name], f"{_stem(name)}.on.{_stem(current)}")
                 for name, task, _, side in again]
         for name, fit in _fits_of(jobs, key, alone, workers, progress, "pairs again").items():
             if fit.calibration_nrmse < fits[name].calibration_nrmse:  # its cost includes both refits
