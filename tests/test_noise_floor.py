@@ -79,3 +79,61 @@ def test_the_level_scaled_estimate_lies_between_the_lowest_level_rule_and_each_r
         assert constant[r.name][0] <= scaled[r.name][0] <= alone * (1 + 1e-9)
     assert scaled[recs[0].name][0] == constant[recs[0].name][0]
     assert abs(scaled[recs[0].name][0] / truth[0] - 1) <= 0.1
+
+
+def swept(fs: float, f_top: float, lead_s: float = 0.0, input_noise: float = 0.0, zero: float = 0.0, seed: int = 5):
+    """The acceleration of a 6 s linear displacement sweep from 5 Hz to f_top [Hz] (amplitude growing with the
+    frequency squared; a 1 s ramp from its start), after lead_s [s] of rest (the input's sensor noise
+    input_noise and zero reading `zero` only), through a 40 Hz resonance (Q = 8; the output's unit) plus white
+    sensor noise SIGMA; the record and its true floor (NRMSE)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(6.0 * fs)) / fs
+    f = 5.0 + (f_top - 5.0) / 6.0 * t
+    drive = np.minimum(t, 1.0) * (f / f_top) ** 2 * np.sin(2 * np.pi * (5.0 * t + 0.5 * (f_top - 5.0) / 6.0 * t**2))
+    u = np.concatenate([np.zeros(int(lead_s * fs)), drive])
+    br, ar = ss.iirpeak(40 / (fs / 2), 8)
+    y = 50 * ss.lfilter(br, ar, u) + SIGMA * rng.standard_normal(len(u))
+    u = u + zero + input_noise * rng.standard_normal(len(u))
+    return Record("sweep", "level 1", 1.0, fs, {"u": u}, {"y": y}, 0), SIGMA / np.sqrt(np.mean(y**2))
+
+
+def test_a_sweep_that_ramps_up_from_its_first_sample_has_no_rest_segment(measured):
+    """The ramp's first 0.2 s stays below 1 % of the input's peak while the output already answers it: taken as
+    rest, it would count that answer as noise. rest_samples finds next to no rest; the quiet band above the
+    sweep gives the floor."""
+    rec, truth = swept(750.0, 60.0)
+    u, y = rec.inputs["u"], rec.outputs["y"]
+    below_one_percent = np.flatnonzero(np.abs(u) > 0.01 * np.abs(u).max())[0]
+    assert below_one_percent >= 0.2 * rec.fs
+    assert np.std(y[:below_one_percent]) > 1.5 * SIGMA  # the ramp's answer in that lead-up
+    assert localise.rest_samples(u, rec.fs) < 0.2 * rec.fs
+    var, method = localise.channel_noise([rec])["sweep"]["y"]
+    assert method == "quiet band"
+    measured("noise floor, sweep ramped from its first sample: |estimate / true floor - 1|",
+             abs(np.sqrt(var / np.mean(y**2)) / truth - 1), 0.1)
+
+
+def test_a_sweep_after_half_a_second_at_rest_takes_its_floor_from_the_rest(measured):
+    """0.5 s of rest before the ramp, the input showing only its sensor's noise about a zero reading of 2 (a
+    DC accelerometer's 1 g, say): the rest lasts at least until one 50 ms window before the shaker's start (and
+    on while the ramp is still below the input's noise) and the output there is the sensor noise (at least 340
+    samples: the estimate's own scatter is at most 4 %)."""
+    rec, truth = swept(750.0, 60.0, lead_s=0.5, input_noise=1e-3, zero=2.0)
+    assert localise.rest_samples(rec.inputs["u"], rec.fs) >= 0.45 * rec.fs
+    var, method = localise.channel_noise([rec])["sweep"]["y"]
+    assert method == "pre-excitation"
+    measured("noise floor, sweep after 0.5 s at rest: |estimate / true floor - 1|",
+             abs(np.sqrt(var / np.mean(rec.outputs["y"] ** 2)) / truth - 1), 0.15)
+
+
+def test_a_sweep_sampled_below_five_times_its_top_frequency_takes_the_quiet_band_from_1_25x(measured):
+    """A sweep to 110 Hz sampled at 500 Hz (a damper's test band at a lab's usual rate): no band from 2x its top
+    frequency below 0.4 fs, but one from 1.25x; the local polynomial method, the fallback, is far above the
+    sensor noise on a 6 s sweep through a sharp resonance."""
+    rec, truth = swept(500.0, 110.0)
+    y = rec.outputs["y"]
+    var, method = localise.channel_noise([rec])["sweep"]["y"]
+    assert method == "quiet band"
+    measured("noise floor, sweep to 0.22 fs: |quiet band from 1.25x / true floor - 1|",
+             abs(np.sqrt(var / np.mean(y**2)) / truth - 1), 0.1)
+    assert np.sqrt(localise.local_polynomial_noise(rec.inputs["u"], y) / np.mean(y**2)) > 3 * truth

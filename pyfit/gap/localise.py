@@ -38,11 +38,12 @@ def _resolution_variance(y: np.ndarray) -> float:
 def _noise_variance(rec: Record, y: np.ndarray) -> tuple[float, str]:
     """Noise variance of one output channel and how it was estimated:
     - 'period scatter': two or more periods of a periodic record: the variance between periods;
-    - 'pre-excitation': the record starts with at least 0.2 s before the input rises above 1 % of its peak;
+    - 'pre-excitation': the record starts at rest for at least 0.2 s (rest_samples);
     - 'unexcited lines': a single period of a periodic record: the DFT lines the input does not excite (an
       upper bound: distortion lands there too);
     - 'quiet band': white noise level from the output PSD between 2x the highest excited frequency and
-      0.4 fs (median over the bins, so that harmonic lines there do not count), when that band exists;
+      0.4 fs (median over the bins, so that harmonic lines there do not count), or from 1.25x when the band
+      from 2x holds fewer than 8 bins (a record sampled at less than 5x its top frequency);
     - 'local polynomial': otherwise the local polynomial method (Pintelon & Schoukens) on the record's DFT:
       around every line the output is fitted as a smooth FRF times the input plus a smooth transient term
       (polynomials of degree 2 over 13 neighbouring lines); the residual power is the noise (an upper
@@ -51,9 +52,9 @@ def _noise_variance(rec: Record, y: np.ndarray) -> tuple[float, str]:
     spp = rec.samples_per_period
     if spp and rec.n // spp >= 2:
         return float(np.mean(np.var(y[:rec.n // spp * spp].reshape(-1, spp), axis=0, ddof=1))), "period scatter"
-    rising = np.flatnonzero(np.abs(u) > 0.01 * np.max(np.abs(u)))
-    if rising.size and rising[0] >= 0.2 * rec.fs:
-        return float(np.var(y[:rising[0]])), "pre-excitation"
+    rest = rest_samples(u, rec.fs)
+    if rest >= 0.2 * rec.fs:
+        return float(np.var(y[:rest])), "pre-excitation"
     if spp:
         U, Y = np.fft.rfft(u), np.fft.rfft(y)
         quiet = np.abs(U) ** 2 < 1e-8 * np.max(np.abs(U) ** 2)
@@ -66,9 +67,30 @@ def _noise_variance(rec: Record, y: np.ndarray) -> tuple[float, str]:
     f_hi = f[on[-1]] if on.size else 0.0
     _, pyy = scipy.signal.welch(y, rec.fs, nperseg=int(seg * rec.fs))
     quiet = (f >= 2 * f_hi) & (f <= 0.4 * rec.fs)
+    if quiet.sum() < 8:
+        quiet = (f >= 1.25 * f_hi) & (f <= 0.4 * rec.fs)
     if quiet.sum() >= 8:
         return float(np.median(pyy[quiet]) * rec.fs / 2), "quiet band"
     return local_polynomial_noise(u, y), "local polynomial"
+
+
+def rest_samples(u: np.ndarray, fs: float, window_s: float = 0.05, factor: float = 1.5) -> int:
+    """Samples [count] before the excitation starts. With the input taken about its first window's mean (the
+    sensor's zero; window_s [s], at least 16 samples): up to the first window whose RMS exceeds `factor` x the
+    first window's, or to the first sample above 1 % of the peak if that comes earlier. An input that ramps up
+    from its first sample (a sweep's or a noise record's fade-in) leaves next to none; an input at rest (zero
+    or its sensor's noise) until the shaker starts leaves that lead-in, where the output is sensor noise alone.
+    The factor 1.5 lies 4 standard deviations above the RMS scatter of noise over a 16-sample window (the
+    shortest), so the input's own noise does not end a rest."""
+    w = max(16, int(round(window_s * fs)))
+    n = len(u) // w
+    if n == 0:
+        return 0
+    x = u - np.mean(u[:w])
+    rms = np.sqrt(np.mean(x[:n * w].reshape(n, w) ** 2, axis=1))
+    rising = np.flatnonzero(rms > factor * rms[0])
+    large = np.flatnonzero(np.abs(x) > 0.01 * np.max(np.abs(x)))
+    return int(min(rising[0] * w if rising.size else len(u), large[0] if large.size else len(u)))
 
 
 def local_polynomial_noise(u: np.ndarray, y: np.ndarray, degree: int = 2, half_width: int = 6) -> float:
