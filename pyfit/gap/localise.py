@@ -74,23 +74,30 @@ def _noise_variance(rec: Record, y: np.ndarray) -> tuple[float, str]:
     return local_polynomial_noise(u, y), "local polynomial"
 
 
-def rest_samples(u: np.ndarray, fs: float, window_s: float = 0.05, factor: float = 1.5) -> int:
-    """Samples [count] before the excitation starts. With the input taken about its first window's mean (the
-    sensor's zero; window_s [s], at least 16 samples): up to the first window whose RMS exceeds `factor` x the
-    first window's, or to the first sample above 1 % of the peak if that comes earlier. An input that ramps up
-    from its first sample (a sweep's or a noise record's fade-in) leaves next to none; an input at rest (zero
-    or its sensor's noise) until the shaker starts leaves that lead-in, where the output is sensor noise alone.
-    The factor 1.5 lies 4 standard deviations above the RMS scatter of noise over a 16-sample window (the
-    shortest), so the input's own noise does not end a rest."""
+def rest_samples(u: np.ndarray, fs: float, window_s: float = 0.05, factor: float = 2.0) -> int:
+    """Samples [count] before the excitation starts. The input is split into windows of window_s [s] (at least
+    16 samples); the excitation starts in the first window whose RMS about the mean of all the windows before it
+    (the sensor's zero as known so far) exceeds `factor` x theirs, or at the first sample above 1 % of the peak
+    (about the first window's mean) if that comes earlier; the window before that start is left out too (a
+    ramp still within the input's noise already moves the output). An input that ramps up from its first sample (a sweep's or a noise
+    record's fade-in) leaves none; an input at rest (zero or its sensor's noise) until the shaker starts leaves
+    that lead-in, where the output is sensor noise alone. With factor 2, the input's white noise alone seldom
+    ends a rest early (tests/test_noise_floor.py measures how seldom)."""
     w = max(16, int(round(window_s * fs)))
     n = len(u) // w
-    if n == 0:
+    if n < 2:
         return 0
     x = u - np.mean(u[:w])
-    rms = np.sqrt(np.mean(x[:n * w].reshape(n, w) ** 2, axis=1))
-    rising = np.flatnonzero(rms > factor * rms[0])
+    win = x[:n * w].reshape(n, w)
+    k = np.arange(1, n)  # each window after the first, against the k windows before it
+    zero = np.cumsum(win.sum(axis=1))[:-1] / (k * w)  # their mean: the sensor's zero as known so far
+    square = np.cumsum((win**2).sum(axis=1))[:-1] / (k * w)
+    before = np.sqrt(np.maximum(square - zero**2, 0.0) * k * w / (k * w - 1))  # their RMS about it (unbiased)
+    dev = np.sqrt(np.mean((win[1:] - zero[:, None]) ** 2, axis=1))  # the window's about it
+    rising = np.flatnonzero(dev > factor * before)
+    start = rising[0] if rising.size else n  # the window before the one the excitation starts in
     large = np.flatnonzero(np.abs(x) > 0.01 * np.max(np.abs(x)))
-    return int(min(rising[0] * w if rising.size else len(u), large[0] if large.size else len(u)))
+    return int(min(start * w, large[0] if large.size else len(u)))
 
 
 def local_polynomial_noise(u: np.ndarray, y: np.ndarray, degree: int = 2, half_width: int = 6) -> float:
