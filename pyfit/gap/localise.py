@@ -79,10 +79,10 @@ def rest_samples(u: np.ndarray, fs: float, window_s: float = 0.05, factor: float
     16 samples); the excitation starts in the first window whose RMS about the mean of all the windows before it
     (the sensor's zero as known so far) exceeds `factor` x theirs, or at the first sample above 1 % of the peak
     (about the first window's mean) if that comes earlier; the window before that start is left out too (a
-    ramp still within the input's noise already moves the output). An input that ramps up from its first sample (a sweep's or a noise
-    record's fade-in) leaves none; an input at rest (zero or its sensor's noise) until the shaker starts leaves
-    that lead-in, where the output is sensor noise alone. With factor 2, the input's white noise alone seldom
-    ends a rest early (tests/test_noise_floor.py measures how seldom)."""
+    ramp still within the input's noise already moves the output). An input that ramps up from its first
+    sample (a sweep's or a noise record's fade-in) leaves none; an input at rest (zero or its sensor's noise)
+    until the shaker starts leaves that lead-in, where the output is sensor noise alone. With factor 2, the
+    input's white noise alone seldom ends a rest early (tests/test_noise_floor.py measures how seldom)."""
     w = max(16, int(round(window_s * fs)))
     n = len(u) // w
     if n < 2:
