@@ -116,8 +116,8 @@ def test_a_sweep_that_ramps_up_from_its_first_sample_has_no_rest_segment(measure
 def test_a_sweep_after_half_a_second_at_rest_takes_its_floor_from_the_rest(measured):
     """0.5 s of rest before the ramp, the input showing only its sensor's noise about a zero reading of 2 (a
     DC accelerometer's 1 g, say): the rest lasts at least until one 50 ms window before the shaker's start (and
-    on while the ramp is still below the input's noise) and the output there is the sensor noise (at least 340
-    samples: the estimate's own scatter is at most 4 %)."""
+    on while the ramp is still below the input's noise) and the output there is the sensor noise (at least 0.45 s,
+    338 samples: the estimate's own scatter is at most 4 %)."""
     rec, truth = swept(750.0, 60.0, lead_s=0.5, input_noise=1e-3, zero=2.0)
     assert localise.rest_samples(rec.inputs["u"], rec.fs) >= 0.45 * rec.fs
     var, method = localise.channel_noise([rec])["sweep"]["y"]
