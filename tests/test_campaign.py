@@ -21,6 +21,13 @@ def test_the_draw_is_reproducible_and_spans_nulls_singles_and_pairs():
     assert abs(kinds.count(0) - 40) < 4 * 7 and abs(kinds.count(1) - 120) < 4 * 7 and abs(kinds.count(2) - 40) < 4 * 7
     assert {c.excitation for c in a} == {"multisine", "sweep", "stepped_sine", "noise"}
     assert {c.outputs for c in a} == {("y",), ("a",)}
+    # each withheld effect's size over the noise drawn log-uniformly over 0.5-20 x: the share below 1.25 x within
+    # four binomial standard deviations of log(2.5) / log(40)
+    sizes = [v for c in a if c.sizes for v in c.sizes.values()]
+    assert all(set(c.sizes or ()) == set(c.withheld.split("+")) - {"none"} for c in a)
+    assert all(campaign.sizing.SIZE_RANGE[0] <= v <= campaign.sizing.SIZE_RANGE[1] for v in sizes)
+    share = np.log(1.25 / 0.5) / np.log(20 / 0.5)
+    assert abs(sum(v < 1.25 for v in sizes) - share * len(sizes)) < 4 * np.sqrt(share * (1 - share) * len(sizes))
     # loop sharpness across the family, none at a start's ν (the candidate starts at whole values)
     nus = [c.truth["nu"] for c in a if "nu" in c.truth]
     assert min(nus) < 1.2 and max(nus) > 2.8 and all(1.0 <= nu <= 3.0 for nu in nus)
@@ -183,8 +190,11 @@ def test_the_summary_tells_misses_the_data_cannot_decide_from_misses_of_the_sear
 @pytest.mark.slow
 def test_a_short_campaign_on_a_local_dask_cluster(tmp_path, fmu_dir, measured):
     summary = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)
-    measured("short campaign (20 random SDOF cases): top-1 accuracy on cases with a withheld effect",
-             summary["top1"], 0.7, at_least=True)  # a guard below the 200-case campaign's (docs/validation.md)
+    # effects drawn from half the noise to twenty times it: many of them the data cannot decide, so the guard is on
+    # the cases they do (the 200-case campaign's: 88 % of 94, docs/validation.md; 3 binomial standard deviations
+    # below it for the ten or so of 20 cases)
+    measured("short campaign (20 random SDOF cases): top-1 accuracy on the cases detected and decided by the data",
+             summary["top1_decided"], 0.55, at_least=True)
     measured("short campaign: false alarms on the null cases", summary["false_alarms"], 0)
     assert summary["errors"] == 0
     (tmp_path / "case0003" / "outcome.json").unlink()  # as if interrupted before its end

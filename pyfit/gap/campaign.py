@@ -3,7 +3,9 @@ CasADi reference through pyfit.gap.datasets), written as a lab writes files, dia
 process pool or a Dask cluster), and judged against what was withheld.
 
 Each case draws: nothing (a null case), one effect or a pair; each effect's strength log-uniformly from
-`STRENGTH_RANGE` times the family's reference strength (a hysteresis loop of random shape, ν from 1 to 3); the
+`STRENGTH_RANGE` times the family's reference strength (a hysteresis loop of random shape, ν from 1 to 3), and its
+own size over the sensor noise, log-uniformly from `sizing.SIZE_RANGE`, to which that strength is scaled on the
+case's own records when they are written (pyfit.gap.sizing; the summary bins by the size the records show); the
 excitation (two periods of a random-odd multisine, or a linear sweep, a stepped sine or band-limited noise
 from rest, `record_s` long: records shorter than a test campaign's, to keep 200 cases near two hours on two
 cores); the output recorded (displacement or acceleration); the noise seed. The effect-to-noise ratio of a
@@ -23,19 +25,20 @@ from __future__ import annotations
 import dataclasses
 import json
 import pathlib
+import tempfile
 import time
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from pyfit.gap import confidence, datasets
+from pyfit.gap import confidence, datasets, sizing
 from pyfit.gap.diagnose import DiagnoseConfig, diagnose, load_config, misfit_at, with_family_drive
 from pyfit.gap.systems import FAMILY
 from pyfit.io.nominal import NominalModel
 from pyfit.runtime.batch import map_tasks
 
 EFFECTS = ("hysteresis", "cubic_stiffness", "coulomb_friction", "quadratic_damping")
-STRENGTH_RANGE = (0.05, 2.0)  # factor on the family's reference strength, drawn log-uniformly
+STRENGTH_RANGE = (0.05, 2.0)  # factor on the family's reference strength, drawn log-uniformly: the sizing's start
 SHARES = {"none": 0.2, "single": 0.6, "pair": 0.2}  # how often a case withholds nothing, one effect, two
 ENR_BINS = (0.0, 2.0, 5.0, 10.0, 20.0, np.inf)  # effect-to-noise ratio bins of the detection-limit table
 RECORD_S, PERIODS = 6.0, 2  # a sweep's, stepped sine's or noise record's length [s]; multisine periods kept
@@ -43,9 +46,10 @@ RECORD_S, PERIODS = 6.0, 2  # a sweep's, stepped sine's or noise record's length
 
 @dataclass(frozen=True)
 class Case:
-    """One drawn case: what is withheld (a '+'-joined name, 'none'), its truth parameters, how it is recorded;
-    for a damper also its geometry (FMU parameters, the messenger's EI among them), the clamp motion recorded
-    and the test band [Hz]."""
+    """One drawn case: what is withheld (a '+'-joined name, 'none'), its truth parameters (each effect at its
+    drawn strength, scaled to `sizes` when the case is written), how it is recorded; for a damper also its
+    geometry (FMU parameters, the messenger's EI among them), the clamp motion recorded and the test band [Hz];
+    each withheld effect's size over the sensor noise to be written at."""
 
     index: int
     withheld: str
@@ -57,6 +61,7 @@ class Case:
     base: dict | None = None
     motion: str = "xva"
     band_hz: tuple | None = None
+    sizes: dict | None = None
 
 
 def hysteresis_loop(rng) -> dict:
@@ -129,8 +134,9 @@ DAMPER_MOTIONS = ("x", "a", "xva")  # clamp displacement, acceleration, or all t
 
 def draw(n: int, seed: int = 0, model: str = "sdof") -> list[Case]:
     """n cases of `model` ('sdof' or 'damper') drawn with numpy's generator from `seed` (the same n, seed and
-    model give the same cases)."""
-    rng = np.random.default_rng(seed)
+    model give the same cases). The sizes come from a generator of their own (seeded with (seed, 1)), so that
+    every other draw of a case is the one the same seed gave before sizes were drawn."""
+    rng, size_rng = np.random.default_rng(seed), np.random.default_rng((seed, 1))
     cases = []
     for i in range(n):
         kind = rng.choice(list(SHARES), p=list(SHARES.values()))
@@ -139,14 +145,15 @@ def draw(n: int, seed: int = 0, model: str = "sdof") -> list[Case]:
         for e in effects:
             truth.update(_effect_truth(e, rng) if model == "sdof" else _damper_effect_truth(e, rng))
         withheld = "+".join(sorted(effects)) or "none"
+        sizes = sizing.drawn_sizes([str(e) for e in effects], size_rng) or None
         if model == "sdof":
             cases.append(Case(i, withheld, truth, str(rng.choice(datasets.EXCITATIONS)),
-                              (str(rng.choice(["y", "a"])),), int(rng.integers(1 << 30))))
+                              (str(rng.choice(["y", "a"])),), int(rng.integers(1 << 30)), sizes=sizes))
             continue
         base, band = damper_geometry(rng)
         cases.append(Case(i, withheld, truth, str(rng.choice(datasets.CLAMP_EXCITATIONS)),
                           DAMPER_OUTPUTS[rng.integers(len(DAMPER_OUTPUTS))], int(rng.integers(1 << 30)), "damper",
-                          base, str(rng.choice(DAMPER_MOTIONS)), band))
+                          base, str(rng.choice(DAMPER_MOTIONS)), band, sizes))
     return cases
 
 
@@ -172,8 +179,17 @@ def run_case(job: CaseJob) -> dict:
     if c.band_hz:
         family = dataclasses.replace(family, band_hz=tuple(c.band_hz))
     style = datasets.LabStyle(c.excitation, tuple(c.outputs), c.motion, record_s=job.record_s)
-    data = datasets.write_dataset(folder / "data", family, c.withheld, seed=c.seed, periods=PERIODS, style=style,
-                                  base=c.base, truth=c.truth or None)
+
+    def write(truth, to):
+        return datasets.write_dataset(to, family, c.withheld, seed=c.seed, periods=PERIODS, style=style,
+                                      base=c.base, truth=truth or None)
+
+    def sizes_of(truth):  # each withheld effect's size over the noise on the records written with `truth`
+        with tempfile.TemporaryDirectory() as scratch:
+            return json.loads((write(truth, scratch) / "truth.json").read_text())["member_to_noise"]
+
+    c = dataclasses.replace(c, truth=sizing.sized(c.truth, c.model, c.sizes, sizes_of)) if c.sizes else c
+    data = write(c.truth, folder / "data")
     # the user describes the damper's geometry; the messenger's EI and damping (the family's linear parameters)
     # are what the nominal calibrates
     linear = FAMILY[c.model].linear

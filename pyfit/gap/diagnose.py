@@ -257,9 +257,10 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
                   screening: dict, runner, out: pathlib.Path, key: str, workers, progress):
     """Forward selection while a model's held-out misfit is above the noise (selection.significant with
     `cfg.combination_min_gap`), from each of the `cfg.beam` best single effects (by score; a flexible stand-in
-    can lead, the true first member come second): extend the model by each of the `cfg.partners` other effects
-    whose sensitivity at that model explains most of its calibration residual (the screening repeated there;
-    none when the model already meets the absolute criterion and no candidate explains
+    can lead, the true first member come second; a change of the linear system below the first whose refit removes
+    less than `cfg.min_shrink_pct` of the gap starts none: selection.worth_a_path): extend the model by each of the
+    `cfg.partners` other effects whose sensitivity at that model explains most of its calibration residual (the
+    screening repeated there; none when the model already meets the absolute criterion and no candidate explains
     `cfg.min_partner_explained` of that residual: the path ends there, and so does the search unless that model
     holds a free-shape loop whose misfit is still above the noise, a possible stand-in). Each partner is refitted
     beside the model so far held at its own refit (attribute.pinned); the one that helps most there, the best of
@@ -612,7 +613,10 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         # whose sensitivity explains most of the nominal residual: it may stand in for that effect (a hardening
         # spring's jump on a held-out sweep costs the spring its score), so the path from that effect goes first
         starts = [screened] + [n for n in starts if n != screened]
-    for start in starts:
+    for rank, start in enumerate(starts):
+        if rank and not selection.worth_a_path(selection.shrink_pct(before, after[start], floor),
+                                               effects[start].linear, cfg.min_shrink_pct):
+            continue  # a linear change that removes little of the gap: its path would add the first path's partners
         if any(after[e] <= explained_below and start in (effects[e].members or (e,))
                and (not stand_in(e) or found_beside(e)) for e in ends):
             break  # an earlier path's end explains the data and holds this start already (a loop found beside

@@ -54,6 +54,14 @@ def shrink_pct(before: float, after: float, reference: float) -> float:
     return 100.0 * (before - after) / (before - reference) if before > reference else 0.0
 
 
+def worth_a_path(shrink: float, linear: bool, min_shrink_pct: float) -> bool:
+    """Whether a single effect that is not the first start of the forward selection starts a path of its own: a
+    nonlinear one always; a change of the linear system itself (a sensor delay, the mass offsets) only when its
+    refit removes `min_shrink_pct` [%] of the gap. A linear change that removes less holds nothing a nonlinear
+    partner needs beside it: every partner is refitted with the linear parameters free on the first path."""
+    return not linear or shrink >= min_shrink_pct
+
+
 def score(before: float, after: float, reference: float, strengths: int) -> float:
     """Shrink [%] less PENALTY_POINTS per strength parameter beyond the first: what a candidate pays for."""
     return shrink_pct(before, after, reference) - PENALTY_POINTS * (strengths - 1)

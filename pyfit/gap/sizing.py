@@ -1,0 +1,69 @@
+"""Withheld effects drawn at a size over the sensor noise rather than at a strength.
+
+An effect's size is what datasets.write_dataset records as `member_to_noise`: the RMS of the truth less the truth
+with that effect off, over the RMS of the sensor noise, on the very records a case writes. The same strength
+shows below the noise on one sensor set and excitation and hundreds of times above it on another, so a campaign
+that is to map the detection limit draws the size and scales each withheld effect's strength parameters until the
+records show it (`sized`)."""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+SIZE_RANGE = (0.5, 20.0)  # an effect's own size over the sensor noise, drawn log-uniformly
+ROUNDS = 2  # rounds of scaling a single effect (each writes the records once), one more for a pair; the records
+# written last measure the size got
+MAX_STEP = 100.0  # one round scales a strength by at most this factor either way
+# the strength parameters each effect's size is scaled by (an SDOF loop's β follows its α: `scaled`)
+STRENGTHS = {
+    "sdof": {"hysteresis": ("alpha",), "cubic_stiffness": ("k3",), "coulomb_friction": ("F_c",),
+             "quadratic_damping": ("c2",)},
+    "damper": {"hysteresis": ("k_bw1", "k_bw2"), "cubic_stiffness": ("k_cs1", "k_cs2"),
+               "coulomb_friction": ("F_c1", "F_c2"), "quadratic_damping": ("c2_1", "c2_2")},
+}
+SDOF_STIFFNESS = 1e5  # a drawn SDOF loop's small-amplitude stiffness k + α [N/m], kept as α is scaled
+MAX_LOOP_SHARE = 0.95  # of it, the most α may take (k stays positive)
+
+
+def drawn_sizes(effects: list[str], rng) -> dict[str, float]:
+    """A size over the noise for each effect, log-uniform over SIZE_RANGE."""
+    return {e: float(np.exp(rng.uniform(*np.log(SIZE_RANGE)))) for e in effects}
+
+
+def max_gain(truth: dict, model: str, effect: str) -> float:
+    """The largest factor an effect's strength may take: an SDOF loop's α at most MAX_LOOP_SHARE of
+    SDOF_STIFFNESS; no bound otherwise."""
+    return MAX_LOOP_SHARE * SDOF_STIFFNESS / truth["alpha"] if (model, effect) == ("sdof", "hysteresis") else np.inf
+
+
+def scaled(truth: dict, model: str, gains: dict[str, float]) -> dict:
+    """`truth` with each effect's strength parameters (STRENGTHS) times its gain. An SDOF loop (theory §1.1) is
+    scaled as a whole: z and α by the gain g, β by g^(1-ν), so that z/g obeys the loop's law unchanged (the
+    displacement where it turns over stays) and its force is g times the loop's; k then at SDOF_STIFFNESS - α."""
+    out = dict(truth)
+    for effect, gain in gains.items():
+        for name in STRENGTHS[model][effect]:
+            out[name] = truth[name] * gain
+        if model == "sdof" and effect == "hysteresis":
+            out["beta"] = truth["beta"] * gain ** (1.0 - truth["nu"])
+            out["k"] = SDOF_STIFFNESS - out["alpha"]
+    return out
+
+
+def sized(truth: dict, model: str, targets: dict[str, float], sizes_of: Callable[[dict], dict],
+          rounds: int | None = None) -> dict:
+    """`truth` with each effect of `targets` (effect -> its size over the noise wanted) scaled to show at that
+    size: `sizes_of(truth)` measures every effect's size (on the records written with that truth), and each round
+    scales a strength by target / size. An effect small beside the noise grows in proportion to its strength, so
+    the second round lands near its target wherever the first started (a strong spring's jump or a saturated loop
+    far from proportion); a third corrects a pair's members for each other (each one's size is measured with
+    the other on). rounds: None for ROUNDS, one more for a pair."""
+    gains = {e: 1.0 for e in targets}
+    for _ in range(rounds or ROUNDS + (len(targets) > 1)):
+        now = sizes_of(scaled(truth, model, gains))
+        for e, target in targets.items():
+            if now.get(e, 0.0) > 0:
+                step = float(np.clip(target / now[e], 1.0 / MAX_STEP, MAX_STEP))
+                gains[e] = min(gains[e] * step, max_gain(truth, model, e))
+    return scaled(truth, model, gains)
