@@ -51,16 +51,15 @@ def scaled(truth: dict, model: str, gains: dict[str, float]) -> dict:
     return out
 
 
-def sized(truth: dict, model: str, targets: dict[str, float], sizes_of: Callable[[dict], dict],
-          rounds: int | None = None) -> dict:
+def sized(truth: dict, model: str, targets: dict[str, float], sizes_of: Callable[[dict], dict]) -> dict:
     """`truth` with each effect of `targets` (effect -> its size over the noise wanted) scaled to show at that
     size: `sizes_of(truth)` measures every effect's size (on the records written with that truth), and each round
     scales a strength by target / size. An effect small beside the noise grows in proportion to its strength, so
     the second round lands near its target wherever the first started (a strong spring's jump or a saturated loop
     far from proportion); a third corrects a pair's members for each other (each one's size is measured with
-    the other on). rounds: None for ROUNDS, one more for a pair."""
+    the other on): ROUNDS rounds, one more for a pair."""
     gains = {e: 1.0 for e in targets}
-    for _ in range(rounds or ROUNDS + (len(targets) > 1)):
+    for _ in range(ROUNDS + (len(targets) > 1)):
         now = sizes_of(scaled(truth, model, gains))
         for e, target in targets.items():
             if now.get(e, 0.0) > 0:
