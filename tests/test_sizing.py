@@ -1,9 +1,6 @@
 """Withheld effects drawn at a size over the sensor noise (pyfit.gap.sizing): the loop scaled as a whole is the
 same loop times the gain (the Bouc-Wen law integrated here with scipy), and a case's records show each effect at
 the size drawn for it (the CasADi reference through pyfit.gap.datasets)."""
-import json
-import tempfile
-
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -52,9 +49,7 @@ def test_a_drawn_case_is_written_with_its_effects_at_the_sizes_drawn(index):
     style = datasets.LabStyle(case.excitation, case.outputs, record_s=campaign.RECORD_S)
 
     def sizes_of(truth):
-        with tempfile.TemporaryDirectory() as scratch:
-            written = datasets.write_dataset(scratch, family, case.withheld, seed=case.seed, style=style, truth=truth)
-            return json.loads((written / "truth.json").read_text())["member_to_noise"]
+        return datasets.effect_sizes(family, case.withheld, seed=case.seed, style=style, truth=truth)
 
     at_reference = sizes_of(case.truth)
     assert max(at_reference[e] / case.sizes[e] for e in case.sizes) > 5

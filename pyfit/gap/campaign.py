@@ -25,7 +25,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import pathlib
-import tempfile
 import time
 from dataclasses import asdict, dataclass, field
 
@@ -179,17 +178,11 @@ def run_case(job: CaseJob) -> dict:
     if c.band_hz:
         family = dataclasses.replace(family, band_hz=tuple(c.band_hz))
     style = datasets.LabStyle(c.excitation, tuple(c.outputs), c.motion, record_s=job.record_s)
-
-    def write(truth, to):
-        return datasets.write_dataset(to, family, c.withheld, seed=c.seed, periods=PERIODS, style=style,
-                                      base=c.base, truth=truth or None)
-
-    def sizes_of(truth):  # each withheld effect's size over the noise on the records written with `truth`
-        with tempfile.TemporaryDirectory() as scratch:
-            return json.loads((write(truth, scratch) / "truth.json").read_text())["member_to_noise"]
-
-    c = dataclasses.replace(c, truth=sizing.sized(c.truth, c.model, c.sizes, sizes_of)) if c.sizes else c
-    data = write(c.truth, folder / "data")
+    record = dict(seed=c.seed, periods=PERIODS, style=style, base=c.base)
+    if c.sizes:  # each withheld effect scaled to its drawn size on the records as they will be written
+        c = dataclasses.replace(c, truth=sizing.sized(c.truth, c.model, c.sizes, lambda truth: datasets.effect_sizes(
+            family, c.withheld, truth=truth, **record)))
+    data = datasets.write_dataset(folder / "data", family, c.withheld, truth=c.truth or None, **record)
     # the user describes the damper's geometry; the messenger's EI and damping (the family's linear parameters)
     # are what the nominal calibrates
     linear = FAMILY[c.model].linear

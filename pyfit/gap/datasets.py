@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import pathlib
+import tempfile
 from dataclasses import dataclass
 
 import numpy as np
@@ -210,6 +211,15 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
                                                 "member_to_noise": {e: float(np.sqrt(v / channels))
                                                                     for e, v in member_sq.items()}}, indent=1))
     return out
+
+
+def effect_sizes(family: Family, effect: str, seed: int = 0, periods: int = PERIODS, style: LabStyle = LabStyle(),
+                 base: dict | None = None, truth: dict | None = None) -> dict[str, float]:
+    """Each withheld effect's size over the sensor noise (write_dataset's `member_to_noise`) on the records
+    write_dataset would write with these arguments, written to a scratch folder that is removed after."""
+    with tempfile.TemporaryDirectory() as scratch:
+        written = write_dataset(scratch, family, effect, seed, periods, style, base, truth)
+        return json.loads((written / "truth.json").read_text())["member_to_noise"]
 
 
 def _excitation_meta(kind: str, signal, family: Family, level: float, spp: int, periods: int) -> dict:
