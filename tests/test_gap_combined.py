@@ -1,6 +1,7 @@
 """Diagnosis of systems that carry more than one effect, and of hysteresis loops of shapes the candidate's starts
 do not hold: truths drawn at random across the family (a generator independent of the FMUs: the CasADi
 reference integrated by CVODES), never at a start value of the candidate. Slow: `pytest -m slow`."""
+import dataclasses
 import json
 
 import numpy as np
@@ -161,14 +162,19 @@ def test_a_weak_loop_beside_a_strong_cubic_spring_is_named_as_both(tmp_path, fmu
 
 
 def _campaign_case_named(tmp_path, fmu_dir, seed: int, index: int, withheld: str, excitation: str,
-                         model: str = "sdof"):
+                         model: str = "sdof", sized: bool = False):
     """Case `index` of the `model` campaign's draw with `seed` (its withheld effects and excitation checked),
     written and diagnosed as the campaign does (default settings); asserts it is named right; returns the case and
-    the report's best model."""
+    the report's best model. The case is written at its drawn strength (the search behaviour each test names was
+    found there) or, `sized`, scaled to its drawn size over the noise as the campaign writes it (the case returned
+    holds the truth as written)."""
     case = campaign.draw(index + 1, seed=seed, model=model)[index]
     assert case.withheld == withheld and case.excitation == excitation
+    if not sized:
+        case = dataclasses.replace(case, sizes=None)
     outcome = campaign.run_case(campaign.CaseJob(case, str(tmp_path), fmu_dir, campaign.RECORD_S))
     assert outcome["named"] == withheld, outcome["verdict"]
+    case = dataclasses.replace(case, truth=outcome["case"]["truth"])
     report = tmp_path / f"case{index:04d}" / "diagnosis" / "report.json"
     return case, json.loads(report.read_text())["ranking"][0]
 
@@ -294,6 +300,22 @@ def test_a_weak_sharp_loop_softening_on_both_branches_is_named(tmp_path, fmu_dir
     case, best = _campaign_case_named(tmp_path, fmu_dir, 17, 132, "hysteresis", "sweep")
     measured("SDOF with a weak, sharp loop softening on both branches under sweeps: fitted alpha relative to the "
              "withheld value", abs(best["params"]["alpha"] / case.truth["alpha"] - 1), 0.01)
+
+
+def test_a_very_weak_loop_is_named(tmp_path, fmu_dir, measured):
+    """A very weak hysteretic element (0.2 % of the stiffness, its loop 9 times the noise) under sweeps recorded as
+    displacement (a case of the campaign's draw at its drawn size, CasADi reference): refitted from the shares of
+    3 % up, the loop ends nearly linear and several times as strong, and fits the held-out files worse than the
+    truth; from the weakest share's starts it is named and fits the held-out files as well as the truth does. A
+    loop this weak trades its strength against its sharpness within the noise (measured: α 17 % above the truth's
+    at ν 1.1 against 1.7), so α is held to within half the truth's."""
+    case, best = _campaign_case_named(tmp_path, fmu_dir, 18, 163, "hysteresis", "sweep", sized=True)
+    assert case.truth["alpha"] < 0.005 * (case.truth["k"] + case.truth["alpha"])
+    outcome = json.loads((tmp_path / "case0163" / "outcome.json").read_text())
+    measured("SDOF with a very weak loop under sweeps: held-out NRMSE of the named model over the truth's",
+             outcome["named_held_out"] / outcome["truth_held_out"], 1.05)  # measured 0.94
+    measured("SDOF with a very weak loop under sweeps: fitted alpha relative to the withheld value",
+             abs(best["params"]["alpha"] / case.truth["alpha"] - 1), 0.5)
 
 
 def test_an_effect_under_the_noise_threshold_is_told_from_noise_by_its_refit(tmp_path, fmu_dir, measured):

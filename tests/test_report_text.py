@@ -11,14 +11,14 @@ def test_a_few_starts_are_written_one_by_one():
 
 
 def test_many_starts_are_summarised_by_parameter():
-    """The SDOF loop's starts (more than LISTED_IN_FULL): ν's three values, the four hysteretic shares of
+    """The SDOF loop's starts (more than LISTED_IN_FULL): ν's three values, the five hysteretic shares of
     k = 1e5 N/m, γ's range from the widest loop's to the largest listed γ, and where the full list is."""
     scale = Scale(1e-3, 0.2, 1e5, {})
     starts = SDOF_EFFECTS["hysteresis"].starts(scale)
     assert len(starts) > LISTED_IN_FULL
     text = starts_text(starts)
     assert "nu in {1, 2, 3}" in text
-    assert "alpha in {3000, 10000, 30000, 60000}" in text
+    assert "alpha in {300, 3000, 10000, 30000, 60000}" in text
     assert "gamma from 0.0025 to 1.5 (" in text
     assert text.endswith("(each start in report.json, `listed_starts`)")
 
