@@ -7,7 +7,8 @@ import time
 import numpy as np
 import pytest
 
-from pyfit.gap import campaign, confidence, datasets
+from pyfit.gap import campaign, confidence, datasets, sizing
+from pyfit.report import generated
 from pyfit.gap.systems import DAMPER_LOOP_STARTS, SDOF_EFFECTS, SDOF_LOOP_STARTS, Scale
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -124,6 +125,19 @@ def test_the_summary_splits_singles_from_pairs_and_counts_a_pair_named_as_one_me
     text = campaign.markdown({**s, "cases": 5, "seed": 0, "record_s": 6.0, "where": "here", "wall_s": 60.0,
                               "command": "c"})
     assert "| pairs | 3 | 33 % | 1 |" in text
+
+
+def test_the_headline_states_the_size_range_the_summary_was_drawn_at(tmp_path):
+    """The README's campaign line reads the sizes the effects were drawn at from the summary (sizing.SIZE_RANGE),
+    not from a copy of its own."""
+    outcomes = [{"withheld": w, "named": n, "enr": 10.0, "top_shrink_pct": None, "stated": None, "data_s": 1.0,
+                 "diagnose_s": 1.0, "verdict": ""} for w, n in [("hysteresis", "hysteresis"), ("none", "none")]]
+    text = campaign.markdown({**campaign.summarise(outcomes), "cases": 2, "seed": 0, "record_s": 6.0,
+                              "where": "here", "wall_s": 60.0, "command": "c"})
+    (tmp_path / "campaign.md").write_text(text, encoding="utf-8")
+    lo, hi = sizing.SIZE_RANGE
+    line = generated._campaign_headline(tmp_path)
+    assert f"each at {lo:g}–{hi:g} × the sensor noise" in line and "in 100 %" in line
 
 
 def test_the_summary_times_nulls_singles_and_pairs_apart():

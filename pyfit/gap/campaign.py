@@ -66,14 +66,14 @@ class Case:
 def hysteresis_loop(rng) -> dict:
     """An SDOF Bouc-Wen loop drawn across the family (theory §1.1), independent of the candidate's starts:
     ν uniform in 1-3 (never one of the starts' whole values); the hysteretic element holds 20-70 % of the
-    stiffness 1e5 N/m and turns over at 30-500 N; loading branch softening (γ + δ from 0.1 to 1.5, or mildly
-    hardening for ν below 1.5), γ − δ from 0.2 to 2.5."""
+    stiffness sizing.SDOF_STIFFNESS (1e5 N/m) and turns over at 30-500 N; loading branch softening (γ + δ from
+    0.1 to 1.5, or mildly hardening for ν below 1.5), γ − δ from 0.2 to 2.5."""
     nu = float(rng.uniform(1.0, 3.0))
     s = rng.uniform(-0.5, 1.5) if nu < 1.5 else rng.uniform(0.1, 1.5)
     d = rng.uniform(0.2, 2.5)
-    alpha = 1e5 * rng.uniform(0.2, 0.7)
+    alpha = sizing.SDOF_STIFFNESS * rng.uniform(0.2, 0.7)
     z_y = 10.0 ** rng.uniform(1.5, 2.7)
-    return {"k": 1e5 - alpha, "alpha": alpha, "beta": alpha / z_y ** nu, "gamma": (s + d) / 2,
+    return {"k": sizing.SDOF_STIFFNESS - alpha, "alpha": alpha, "beta": alpha / z_y ** nu, "gamma": (s + d) / 2,
             "delta": (s - d) / 2, "nu": nu}
 
 
@@ -83,7 +83,7 @@ def _effect_truth(effect: str, rng) -> dict:
     if effect == "hysteresis":
         loop = hysteresis_loop(rng)
         loop["alpha"] *= min(factor, 1.0)
-        loop["k"] = 1e5 - loop["alpha"]
+        loop["k"] = sizing.SDOF_STIFFNESS - loop["alpha"]
         return loop
     ref = datasets.SDOF.withheld[effect]
     strength = {"cubic_stiffness": "k3", "coulomb_friction": "F_c", "quadratic_damping": "c2"}[effect]
@@ -365,7 +365,9 @@ def markdown(s: dict) -> str:
     """The campaign summary as Markdown."""
     system = {"sdof": "SDOF", "damper": "damper (random geometry)"}[s.get("model", "sdof")]
     diagnosed = s["cases"] - s.get("resumed", 0)  # by this run
-    lines = [f"{s['cases']} {system} cases (seed {s['seed']}, records {s['record_s']:g} s), {s['where']}: wall "
+    lo, hi = sizing.SIZE_RANGE
+    lines = [f"{s['cases']} {system} cases (seed {s['seed']}, records {s['record_s']:g} s, each withheld effect at "
+             f"{lo:g}–{hi:g} × the sensor noise), {s['where']}: wall "
              f"{s['wall_s'] / 60:.1f} min"
              + (f" for the {diagnosed} case{'' if diagnosed == 1 else 's'} this run diagnosed ({s['resumed']} read "
                 "from an earlier run" + (f", whose runs took {s['earlier_wall_s'] / 60:.1f} min: a full run takes "

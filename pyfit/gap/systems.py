@@ -287,12 +287,12 @@ BETA_SHARE = 0.3  # the share that sets β's scale (ExponentScaled)
 # the shares each loop width starts from. As listed (width 1: a loop that saturates within the data's deflection),
 # from a very weak element (0.3 %: a loop whose hysteretic force is a few times the noise's; from 3 % up its refit
 # ends at a nearly linear loop several times as strong) and a weak one (3 %: it saturates early and adds a little
-# stiffness and damping) to a strong one; with γ, δ scaled by 0.1 (every share) and by 0.01 (the larger shares:
-# wide loops that barely saturate there, turning over at 10^(1/ν) and 100^(1/ν) times the force β's scale refers
-# to, a mostly elastic element with a little hysteretic damping), and by 0.3 at the smaller shares (a weak element
-# whose loop turns over within a few times that force). A strong element with a wide loop and a weak one with a
-# narrow loop share the first-order nonlinearity (α·β·γ) but lie in separate basins of the least squares, so the
-# refit descends from the best start of each
+# stiffness and damping) to a strong one; with γ, δ scaled by 0.1 (the shares from 3 % up) and by 0.01 (the
+# larger shares: wide loops that barely saturate there, turning over at 10^(1/ν) and 100^(1/ν) times the force
+# β's scale refers to, a mostly elastic element with a little hysteretic damping), and by 0.3 at the smaller
+# shares (a weak element whose loop turns over within a few times that force). A strong element with a wide loop
+# and a weak one with a narrow loop share the first-order nonlinearity (α·β·γ) but lie in separate basins of the
+# least squares, so the refit descends from the best start of each
 LOOP_SHARES = {1.0: (0.003, 0.03, DEFAULT_SHARE, 0.3, 0.6), 0.3: (0.003, 0.03, DEFAULT_SHARE),
                0.1: (0.03, DEFAULT_SHARE, 0.3, 0.6), 0.01: (0.3, 0.6)}
 NARROW_FROM = 0.5  # |γ| + |δ| of a loop start from which it counts as narrow (the listed shapes: 1 to 2)

@@ -213,9 +213,10 @@ def _campaign_headline(res: pathlib.Path) -> str | None:
     if not m:
         return None
     decided = re.search(r"Top-1 accuracy on the (\d+) cases detected and decided by the data: (\d+) %", text)
-    return (f"- **Validation campaign**: on {m[1]} random SDOF cases with one or two withheld effects (each at "
-            "0.5–20 × the sensor noise; random loop shapes, excitations, sensors) the diagnosis names exactly what "
-            "was withheld in "
+    sizes = re.search(r"each withheld effect at ([\d.]+–[\d.]+) × the sensor noise", text)
+    return (f"- **Validation campaign**: on {m[1]} random SDOF cases with one or two withheld effects ("
+            + (f"each at {sizes[1]} × the sensor noise; " if sizes else "")
+            + "random loop shapes, excitations, sensors) the diagnosis names exactly what was withheld in "
             f"{m[2]} %"
             + (f", and in {decided[2]} % of the {decided[1]} left when the misses the data cannot decide are set "
                "aside (a gap within the noise, or the named model fitting the held-out files at least as well as "
