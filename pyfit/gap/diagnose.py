@@ -281,8 +281,8 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     there (and takes the fit when it fits the calibration files better): the longer fit the control stands for.
     The noise these tests measure a misfit above is the floor should the sensor noise grow with the level
     (gap["noise_floor_scaled"]): a floor taken too low asks a right pair to remove half of a misfit that is noise.
-    A path's end is checked backward: the model without its last-added member is refitted from the end's
-    values, and the end is kept only when it still removes `min_excess_cut` of what that refit leaves; an end
+    A path's end is checked backward: the model without each of its members is refitted from the end's
+    values, and the end is kept only when it still removes `min_excess_cut` of what each refit leaves; an end
     still above the absolute criterion is then refitted on from its own values. A path whose start is a member
     of an earlier path's end that explains the data (and is no possible stand-in: a model with a free-shape
     member, systems.Effect.free_shape, still above the noise, unless its loop has no basins and was found beside
@@ -509,17 +509,22 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
             simulated(name)
 
     def pruned(end):
-        # the backward step: the model without its last-added member, refitted from the larger model's values
-        # with half a refit's budget (a loop refitted alone can stop in a basin whose misfit a stand-in partner
-        # then takes up; from the pair's loop it can go on to where the partner adds too little); the larger
-        # model stays only when it still adds enough to that refit
-        members = effects[end].members
-        rest = named.get(frozenset(members[:-1])) if members else None
-        if rest is None:
-            return end
-        onward(rest, fits[end].params, cfg.refit_budget // 2, f"{_stem(end)}.reduced")
-        return end if selection.adds_enough(min(after[rest], controls.get(end, float("inf"))), after[end], above,
-                                            cfg.min_excess_cut) else rest
+        # the backward step: the model without each of its members in turn (the last-added, and the first: a path
+        # that began at a spring can end at the spring plus a loop that holds all of the effect), each refitted
+        # from the larger model's values with half a refit's budget (a loop refitted alone can stop short in a
+        # slow valley whose misfit a stand-in partner then takes up; from the pair's loop it goes on to where the
+        # partner adds too little); the larger model stays only when it still adds enough to every such refit,
+        # else the smaller model it adds least to is the end
+        # (the model it extended, without the last-added member, also against what its control's evaluations
+        # bought it: selection.budget_control)
+        members = effects[end].members or ()
+        rests = {named[frozenset(members) - {m}]: controls.get(end, float("inf")) if m == members[-1]
+                 else float("inf") for m in members if frozenset(members) - {m} in named}
+        for rest in rests:
+            onward(rest, fits[end].params, cfg.refit_budget // 2, f"{_stem(end)}.reduced_to.{_stem(rest)}")
+        short = [r for r, bar in rests.items()
+                 if not selection.adds_enough(min(after[r], bar), after[end], above, cfg.min_excess_cut)]
+        return min(short, key=lambda r: after[r]) if short else end
 
     def kept(a, b):  # of two models (path ends, a path's combinations), the one kept (selection.simpler_or_better)
         sized = [(len(effects[n].members or (n,)), after[n]) for n in (a, b)]

@@ -219,8 +219,8 @@ def _campaign_headline(res: pathlib.Path) -> str | None:
             + "random loop shapes, excitations, sensors) the diagnosis names exactly what was withheld in "
             f"{m[2]} %"
             + (f", and in {decided[2]} % of the {decided[1]} left when the misses the data cannot decide are set "
-               "aside (a gap within the noise, or the named model fitting the held-out files at least as well as "
-               "the truth)" if decided else "")
+               "aside (a gap within the noise, the named model fitting the held-out files at least as well as "
+               "the truth, or the truth itself removing too little of the gap to be named)" if decided else "")
             + f"; false alarms: {m[4]} of {m[3]} null cases ([validation](../validation.md#validation-campaign)).")
 
 
