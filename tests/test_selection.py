@@ -16,6 +16,15 @@ def test_shrink_and_score():
     assert single > pair and single - pair < 1.0
 
 
+def test_a_model_explains_only_with_both_the_shrink_and_the_absolute_criterion():
+    """selection.explains, the report's test and the campaign's for the truth: half the gap removed (the default
+    min_shrink_pct) and the held-out misfit within the absolute criterion, each necessary."""
+    below = selection.explained_below(0.005, 3.0, 0.02)  # 0.025
+    assert selection.explains(50.0, 0.025, below, 50.0)
+    assert not selection.explains(49.9, 0.010, below, 50.0)  # too little of the gap removed
+    assert not selection.explains(99.0, 0.0251, below, 50.0)  # above the absolute criterion
+
+
 def test_a_larger_model_is_kept_only_when_it_removes_half_the_misfit_left_above_the_floor():
     floor, cut = 0.0021, 0.5
     # the pair leaves 0.0033 above the floor, the single loop 0.0186: the pair is kept, in either order

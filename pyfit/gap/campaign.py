@@ -321,10 +321,10 @@ def times_by_kind(outcomes: list[dict]) -> list[dict]:
 
 
 def _truth_named(o: dict) -> bool:
-    """Whether the report's test for 'explained' would name the truth at its true parameters: its held-out misfit
-    within the explanation threshold and (outcomes that hold it: truth_test) its shrink of the gap enough."""
-    return (o["truth_held_out"] <= o["explained_below"]
-            and o.get("truth_shrink_pct", float("inf")) >= o.get("min_shrink_pct", 0.0))
+    """Whether the report's test for 'explained' (selection.explains) would name the truth at its true parameters
+    (an outcome without truth_test's fields: by the absolute criterion alone)."""
+    return selection.explains(o.get("truth_shrink_pct", float("inf")), o["truth_held_out"], o["explained_below"],
+                              o.get("min_shrink_pct", 0.0))
 
 
 def split_misses(effects: list[dict], nulls: list[dict]) -> dict:

@@ -168,7 +168,7 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
     explained_below = selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin)
     shrinks = {frozenset(d["members"]): d["shrink_pct"] for d in ranking}
     for d in ranking:
-        d["explains"] = bool(d["shrink_pct"] >= cfg.min_shrink_pct and d["heldout_gap_after"] <= explained_below)
+        d["explains"] = selection.explains(d["shrink_pct"], d["heldout_gap_after"], explained_below, cfg.min_shrink_pct)
         if len(d["members"]) > 1:  # each member's share (selection.member_shares)
             d["member_shares_pct"] = selection.member_shares(d["members"], shrinks.get)
     for d in ranking:

@@ -42,6 +42,12 @@ def explained_below(floor: float, explain_factor: float, explain_margin: float) 
     return max(explain_factor * floor, floor + explain_margin)
 
 
+def explains(shrink: float, after: float, explained_below: float, min_shrink_pct: float) -> bool:
+    """The report's test for 'explained': a model whose held-out shrink of the gap [%] reaches `min_shrink_pct` and
+    whose held-out NRMSE `after` meets the absolute criterion (explained_below)."""
+    return shrink >= min_shrink_pct and after <= explained_below
+
+
 def detected_by_refit(before: float, after: float, min_cut: float) -> bool:
     """Whether a refit finds a gap below the noise threshold: it removes at least `min_cut` (a share, 0-1) of the
     held-out misfit `before` (the nominal's, or its refit's linear values alone when lower). The held-out files'
