@@ -53,6 +53,19 @@ def test_of_two_pairs_both_within_the_noise_the_one_with_fewer_parameters_is_kep
     assert selection.simpler_or_better((2, 0.0080), (2, 0.0070), 0.0049, 0.5, parameters=(2, 5), noise=noise) == 1
 
 
+def test_of_two_single_effects_within_the_noise_a_linear_change_wins_on_its_misfit_alone():
+    """SDOF check campaign case 24 (stockbridge diagnose --campaign 100 --campaign-seed 19; a hardening spring
+    withheld, multisines; misfits as ratios to the floor should the noise grow): the spring (1 parameter) leaves
+    0.9954 and a free-shape loop (4) 0.9949: the spring is kept. Damper campaign case 72 (seed 1, a loop withheld):
+    of the loop (5) at 1.050 and the mass offsets (2, a change of the linear system that within the noise can take
+    up the sensor chain's linear difference) at 1.059, the lower misfit decides."""
+    noise = selection.noise_level(1.0, 1.2, 0.0)
+    assert selection.simpler_or_better((1, 0.9949), (1, 0.9954), 1.0, 0.5, parameters=(4, 1), noise=noise) == 1
+    assert selection.simpler_or_better((1, 1.050), (1, 1.059), 1.0, 0.5, parameters=(5, 2), noise=noise) == 1
+    assert selection.simpler_or_better((1, 1.050), (1, 1.059), 1.0, 0.5, parameters=(5, 2), noise=noise,
+                                       linear=True) == 0
+
+
 def test_of_two_pairs_within_the_noise_but_far_apart_the_lower_misfit_is_kept():
     """Damper campaign case 4 (stockbridge diagnose --campaign 30 --model damper; Coulomb friction with a weak loop
     withheld; floor should the noise grow 0.0133, so both pairs lie under its 1.2x): the true pair (9 parameters)

@@ -295,7 +295,9 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     still shows it, and the loop beside the spring's refit is found on that path (a loop with basins is refitted
     from each, a weak loop's among them). Of the ends of
     these paths, a larger model is selected only by the same rule, and of two as large whose misfits are both
-    within the noise, the one with fewer parameters (selection.simpler_or_better). When then no single effect
+    within the noise, the one with fewer parameters (selection.simpler_or_better; a model holding a change of
+    the linear system wins only on a lower misfit). When the best single effect is already within the noise,
+    nothing is added: the single effect kept by that rule is the model selected. When then no single effect
     and not the model selected meets the absolute criterion and the calibration records are not periodic
     (sweeps, stepped sines, noise), the single effects and pairs of the best of them are fitted to the amplitude
     envelopes first and refitted on the waveforms from there (enveloped, below), and the selection weighs those
@@ -304,7 +306,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     valley where a descent from its members' refits stops short), and the selection is made again with them (the
     envelopes go first: a few fits, where the grid simulates hundreds of points). Adds the fits and held-out
     simulations to `fits` and `sims`; returns the system with the combined effects among its effects and the
-    model selected (None when nothing was tried)."""
+    model selected (None when no single effect was refitted)."""
     before, floor = gap["overall"], gap["noise_floor"]
     above = gap["noise_floor_scaled"]  # the noise the selection measures a misfit above (at least the floor)
     explained_below = selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin)
@@ -320,7 +322,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         return selection.score(before, after[name], floor, fits[name].n_added)
 
     ranked = sorted(fits, key=lambda n: -score(n))
-    if not ranked or not left(ranked[0]):
+    if not ranked:
         return system, None
     effects = dict(system.effects)
     named = {frozenset([n]): n for n in fits}  # members -> the name their model is stored under
@@ -532,7 +534,14 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
         return (a, b)[selection.simpler_or_better(
             *sized, above, cfg.min_excess_cut, controls.get(larger, float("inf")),
             parameters=(len(effects[a].params), len(effects[b].params)),
-            noise=selection.noise_level(above, cfg.noise_factor, cfg.combination_min_gap))]
+            noise=selection.noise_level(above, cfg.noise_factor, cfg.combination_min_gap),
+            linear=any(system.effects[m].linear for n in (a, b) for m in effects[n].members or (n,)))]
+
+    if not left(ranked[0]):
+        # a single effect reaches the noise: nothing to add; of the single effects, the one kept by the same rule
+        # (a loop of free shape and a cubic spring that both reach the noise on the same records, within ALIKE
+        # of each other: the spring, the data no longer tell them apart)
+        return system, functools.reduce(kept, ranked)
 
     def stand_in(name):  # a free-shape loop still above the noise: it may hold another's part
         return any(system.effects[m].free_shape for m in effects[name].members or (name,)) and left(name)

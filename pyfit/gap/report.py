@@ -441,6 +441,11 @@ def markdown(result: dict) -> str:
         lines += ["", f"**{sep['between'][0]} and {sep['between'][1]} score close.** Their refitted models differ "
                   f"most at {best['level']} (NRMSE of the difference {best['difference_nrmse']:.3f}), in the band "
                   f"{best['band_hz'][0]:.1f}-{best['band_hz'][1]:.1f} Hz: measure there to separate them."]
+        first, second = result["ranking"][:2]
+        if (result["chosen_effect"] == first["effect"] and len(first["members"]) == len(second["members"])
+                and first["heldout_gap_after"] > second["heldout_gap_after"]):
+            lines[-1] += (f" Both reach the noise with held-out misfits within {100 * selection.ALIKE:.0f} % of each "
+                          f"other: {first['effect']}, with fewer parameters, is named.")
     lines += ["", "## Where", "", "| band [Hz] | nominal NRMSE contribution (held out) |", "|---|---|"]
     lines += [f"| {b['band_hz'][0]:.1f}-{b['band_hz'][1]:.1f} | {b['nrmse']:.4f} |" for b in g["by_band"]]
     lines += ["", "| file | level | held out | nominal NRMSE | noise floor |", "|---|---|---|---|---|"]

@@ -152,15 +152,17 @@ def lean_rival(joint, loops: set, after: dict, control) -> str | None:
 
 def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, min_excess_cut: float,
                       control: float = float("inf"), parameters: tuple[int, int] = (0, 0),
-                      noise: float = 0.0) -> int:
+                      noise: float = 0.0, linear: bool = False) -> int:
     """Of two models given as (number of effects, held-out NRMSE), the index (0: a, 1: b) of the one kept: of
     two as large, the lower misfit, but the one with fewer `parameters` (each model's count) when both misfits
     are at or below `noise` (noise_level) and its misfit is within ALIKE of the other's (each under the noise,
-    two misfits further apart on the same held-out files still tell the models apart); else the larger only when it
+    two misfits further apart on the same held-out files still tell the models apart), unless `linear` (either
+    model holds a change of the linear system, systems.Effect.linear: within the noise its refit can take up the
+    sensor chain's linear difference, so its few parameters are no evidence); else the larger only when it
     adds enough (adds_enough) to the smaller one credited with what refitting on alone buys it (the larger one's
     budget_control, when below its misfit)."""
     if a[0] == b[0]:
-        if max(a[1], b[1]) <= noise and parameters[0] != parameters[1]:
+        if max(a[1], b[1]) <= noise and parameters[0] != parameters[1] and not linear:
             lean = 0 if parameters[0] < parameters[1] else 1
             if (a, b)[lean][1] <= (1.0 + ALIKE) * (a, b)[1 - lean][1]:
                 return lean
