@@ -338,14 +338,21 @@ def split_misses(effects: list[dict], nulls: list[dict]) -> dict:
     difference that a calibration takes up: `handicap` is its size, the median over the null cases of the truth's
     held-out misfit over the calibrated nominal's (the same structure)."""
     judged = [o for o in effects if o["named"] != o["withheld"] and o.get("truth_held_out") is not None]
-    undetected = [o for o in judged if o["verdict"] == "no significant gap"]
-    undecided = [o for o in judged if o not in undetected and o["named_held_out"] <= o["truth_held_out"]]
-    unnamed = [o for o in judged if o not in undetected and o not in undecided and not _truth_named(o)]
-    searched = [o for o in judged if o not in undetected and o not in undecided and o not in unnamed]
+    causes = [_miss_cause(o) for o in judged]
     same = [o["truth_held_out"] / o["named_held_out"] for o in nulls
             if o["named"] == "none" and o.get("truth_held_out") is not None]
-    return {"judged": len(judged), "undetected": len(undetected), "undecided": len(undecided),
-            "unnamed": len(unnamed), "search": len(searched), "handicap": float(np.median(same)) if same else None}
+    return {"judged": len(judged), **{c: causes.count(c) for c in ("undetected", "undecided", "unnamed", "search")},
+            "handicap": float(np.median(same)) if same else None}
+
+
+def _miss_cause(o: dict) -> str:
+    """What kept a missed case's withheld effect(s) from being named (split_misses): the first that holds of
+    undetected, undecided, unnamed; else search."""
+    if o["verdict"] == "no significant gap":
+        return "undetected"
+    if o["named_held_out"] <= o["truth_held_out"]:
+        return "undecided"
+    return "search" if _truth_named(o) else "unnamed"
 
 
 def summarise(outcomes: list[dict]) -> dict:
@@ -369,11 +376,12 @@ def summarise(outcomes: list[dict]) -> dict:
                            "pair": _tally(inside, 2)})
     calibration = confidence.calibration_of(outcomes, "", 0)
     misses = split_misses(effects, nulls)
+    decided = len(effects) - misses["undetected"] - misses["undecided"] - misses["unnamed"]  # what the data decide
     by_size = [{"kind": kind, **_tally(effects, size)} for size, kind in ((1, "single effects"), (2, "pairs"))]
     return {"labels": labels, "confusion": confusion, "by_size": by_size,
             "top1": sum(o["named"] == o["withheld"] for o in effects) / max(len(effects), 1),
-            "misses": misses, "top1_decided": sum(o["named"] == o["withheld"] for o in effects)
-            / max(len(effects) - misses["undetected"] - misses["undecided"] - misses["unnamed"], 1),
+            "misses": misses, "decided": decided,
+            "top1_decided": sum(o["named"] == o["withheld"] for o in effects) / max(decided, 1),
             "effect_cases": len(effects), "null_cases": len(nulls),
             "false_alarms": sum(o["named"] != "none" for o in nulls), "by_enr": by_enr, "by_weakest": by_weakest,
             "by_shrink": calibration["by_shrink"], "no_gap": calibration["no_gap"], "check": confidence.check(outcomes),
@@ -439,8 +447,8 @@ def markdown(s: dict) -> str:
                   f"{m['unnamed']} |",
                   f"| the truth fits them better and would be named (a miss of the search or of the selection) | "
                   f"{m['search']} |", "",
-                  f"Top-1 accuracy on the {s['effect_cases'] - m['undetected'] - m['undecided'] - m['unnamed']} "
-                  f"cases detected and decided by the data: {100 * s['top1_decided']:.0f} %."]
+                  f"Top-1 accuracy on the {s['decided']} cases detected and decided by the data: "
+                  f"{100 * s['top1_decided']:.0f} %."]
         if m["handicap"] is not None:
             lines += ["", f"The truth at its true parameters carries the sensor chain (anti-alias filter, "
                       f"decimation) and the other simulator, which a calibration takes up: on the null cases its "
