@@ -1,5 +1,7 @@
 """The confidence a report states: Wilson intervals against their definition solved numerically, the campaign's
 calibration table, the bin a report falls in, and the check of stated confidence against the hit rate."""
+import json
+
 import numpy as np
 import pytest
 import scipy.optimize
@@ -81,6 +83,10 @@ def test_a_calibration_is_read_for_the_settings_it_was_made_with_only(tmp_path):
     assert confidence.load({"refit_within_noise": True}, path=path) is None  # a setting it was not made with
     # where the files are (which are calibrated on, the bands) is no setting of the rule
     assert confidence.settings_of({"min_gap": 0.005, "calibration": ["a"], "bands_hz": None}) == {"min_gap": 0.005}
+    # a setting added since: the calibrations made without it can no longer be read, and go
+    confidence.write(confidence.calibration_of(OUTCOMES[:9], "a setting added", 4, {**other, "extend_factor": 1.1}),
+                     path)
+    assert [c["source"] for c in json.loads(path.read_text())["calibrations"]] == ["a setting added"]
 
 
 def test_the_package_carries_a_calibration_of_the_default_settings_from_a_campaign():

@@ -358,6 +358,24 @@ def test_a_spring_a_free_shape_loop_matches_within_the_noise_is_named_as_the_spr
              abs(best["params"]["k3"] / case.truth["k3"] - 1), 0.1)  # measured 0.077
 
 
+
+def test_a_pair_whose_stronger_member_alone_lands_just_above_the_noise_is_extended(tmp_path, fmu_dir, measured):
+    """Quadratic damping with a weak hardening spring under stepped sines recorded as displacement (a case of the
+    campaign's draw at its drawn size, CasADi reference): the damping's refit alone leaves a held-out misfit
+    under the nominal's test (noise_factor x the floor should the noise grow) but above the forward selection's
+    (extend_factor x it), so the spring is tried beside it; the pair is named and both strengths recovered."""
+    case, best = _campaign_case_named(tmp_path, fmu_dir, 18, 76, "cubic_stiffness+quadratic_damping",
+                                      "stepped_sine", sized=True)
+    rep = json.loads((tmp_path / "case0076" / "diagnosis" / "report.json").read_text())
+    single = next(d["heldout_gap_after"] for d in rep["ranking"] if d["effect"] == "quadratic_damping")
+    cfg, above = dg.DiagnoseConfig(), rep["gap"]["noise_floor_scaled"]
+    assert selection.significant(single, above, cfg.extend_factor, cfg.combination_min_gap)
+    assert not selection.significant(single, above, cfg.noise_factor, cfg.combination_min_gap)
+    measured("SDOF pair whose damping alone lands just above the noise: fitted k3 relative to the withheld value",
+             abs(best["params"]["k3"] / case.truth["k3"] - 1), 0.05)  # measured 0.014
+    measured("SDOF pair whose damping alone lands just above the noise: fitted c2 relative to the withheld value",
+             abs(best["params"]["c2"] / case.truth["c2"] - 1), 0.05)  # measured 0.0075
+
 def test_an_effect_under_the_noise_threshold_is_told_from_noise_by_its_refit(tmp_path, fmu_dir, measured):
     """A weak quadratic damping under a sweep recorded as displacement (a case of the check campaign's draw,
     CasADi reference): the nominal's held-out misfit is within the noise threshold, but the damping's

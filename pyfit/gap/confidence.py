@@ -106,8 +106,11 @@ def _stored(path: pathlib.Path) -> list[dict]:
 
 
 def write(calibration: dict, path: pathlib.Path = CALIBRATION) -> pathlib.Path:
-    """Store a calibration (in the package's file by default), in place of one of the same family and settings."""
-    kept = [c for c in _stored(path) if (c["model"], c["settings"]) != (calibration["model"], calibration["settings"])]
+    """Store a calibration (in the package's file by default), in place of one of the same family and settings;
+    those made before a setting was added or after one was removed (other setting names) are dropped: no
+    diagnosis can read them any more."""
+    kept = [c for c in _stored(path) if c["settings"].keys() == calibration["settings"].keys()
+            and (c["model"], c["settings"]) != (calibration["model"], calibration["settings"])]
     path.write_text(json.dumps({"calibrations": kept + [calibration]}, indent=1, default=float) + "\n")
     return path
 

@@ -56,6 +56,8 @@ class DiagnoseConfig:
     min_excess_cut: float = 0.5  # share of the misfit above the noise floor a larger combination must remove
     combination_probes: int = 3  # a combination's best starts each refitted a while before the best goes on
     combination_min_gap: float = 0.0  # NRMSE a model's held-out misfit must exceed beyond the floor to add a member
+    extend_factor: float = 1.1  # ... and the floor (should the noise grow) times this: a weaker test than the
+    # nominal's noise_factor (a pair whose single member lands just above the noise is still extended)
     min_partner_explained: float = 0.005  # a model meeting the absolute criterion is extended only when a
     # candidate's sensitivity explains this share of its calibration residual (the screening at that model)
     grid_models: int = 3  # when no model meets the absolute criterion: the best ones by held-out misfit, each
@@ -256,9 +258,10 @@ def _combination_seeds(system, scale, current: dict, members: list, partner_fit:
 def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, scale, fits: dict, sims: dict, gap,
                   screening: dict, runner, out: pathlib.Path, key: str, workers, progress):
     """Forward selection while a model's held-out misfit is above the noise (selection.significant with
-    `cfg.combination_min_gap`), from each of the `cfg.beam` best single effects (by score; a flexible stand-in
-    can lead, the true first member come second; a change of the linear system below the first whose refit removes
-    less than `cfg.min_shrink_pct` of the gap starts none: selection.worth_a_path): extend the model by each of the
+    `cfg.extend_factor` and `cfg.combination_min_gap`), from each of the `cfg.beam` best single effects (by score;
+    a flexible stand-in can lead, the true first member come second; a change of the linear system below the first
+    whose refit removes less than `cfg.min_shrink_pct` of the gap starts none: selection.worth_a_path): extend
+    the model by each of the
     `cfg.partners` other effects whose sensitivity at that model explains most of its calibration residual (the
     screening repeated there; none when the model already meets the absolute criterion and no candidate explains
     `cfg.min_partner_explained` of that residual: the path ends there, and so does the search unless that model
@@ -314,7 +317,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     alone = workers or os.cpu_count() or 1  # a fit that runs alone simulates its records at once
 
     def left(name):  # a model's held-out misfit is above the noise (a weaker test than the nominal's): go on adding
-        return selection.significant(after[name], above, cfg.noise_factor, cfg.combination_min_gap)
+        return selection.significant(after[name], above, cfg.extend_factor, cfg.combination_min_gap)
 
     after = {n: selection.heldout_nrmse(sims[n], held) for n in fits}
 
@@ -749,9 +752,9 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     clock.end("reading and checking the data")
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)
-    judging = ("min_gap", "noise_factor", "close_points", "min_shrink_pct", "explain_factor", "explain_margin",
-               "nominal_max_nrmse", "max_effects", "partners", "min_excess_cut", "beam", "combination_min_gap",
-               "min_partner_explained", "grid_models", "min_detect_cut", "refit_within_noise")
+    judging = ("min_gap", "noise_factor", "extend_factor", "close_points", "min_shrink_pct", "explain_factor",
+               "explain_margin", "nominal_max_nrmse", "max_effects", "partners", "min_excess_cut", "beam",
+               "combination_min_gap", "min_partner_explained", "grid_models", "min_detect_cut", "refit_within_noise")
     # (how results are judged and which combinations are tried, not how a fit is made: stored fits stay valid)
     settings = json.dumps({k: v for k, v in asdict(cfg).items() if k not in judging}, sort_keys=True)
     description = json.dumps({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}

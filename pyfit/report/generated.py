@@ -80,6 +80,10 @@ RESULTS = {
     "docs/results/campaign_check.md": ("results/campaign_check/summary.md",
                                        "stockbridge diagnose --campaign 100 --campaign-seed 19 --out "
                                        "results/campaign_check"),
+    "docs/results/campaign_threshold.md": ("results/campaign_threshold/summary.md",
+                                           "stockbridge diagnose --campaign 200 --campaign-seed 18 --config "
+                                           "configs/diagnose_nominal_threshold.toml --calibrate --out "
+                                           "results/campaign_threshold"),
     "docs/results/campaign_damper.md": ("results/campaign_damper/summary.md",
                                         "stockbridge diagnose --campaign 30 --model damper --out "
                                         "results/campaign_damper"),
