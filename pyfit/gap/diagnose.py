@@ -261,8 +261,7 @@ def _combinations(system, cfg: DiagnoseConfig, fmu, cal, held, nominal: Fit, sca
     `cfg.extend_factor` and `cfg.combination_min_gap`), from each of the `cfg.beam` best single effects (by score;
     a flexible stand-in can lead, the true first member come second; a change of the linear system below the first
     whose refit removes less than `cfg.min_shrink_pct` of the gap starts none: selection.worth_a_path): extend
-    the model by each of the
-    `cfg.partners` other effects whose sensitivity at that model explains most of its calibration residual (the
+    the model by each of the `cfg.partners` other effects whose sensitivity at that model explains most of its calibration residual (the
     screening repeated there; none when the model already meets the absolute criterion and no candidate explains
     `cfg.min_partner_explained` of that residual: the path ends there, and so does the search unless that model
     holds a free-shape loop whose misfit is still above the noise, a possible stand-in). Each partner is refitted
