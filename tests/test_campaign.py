@@ -154,6 +154,22 @@ def test_the_summary_times_nulls_singles_and_pairs_apart():
     text = campaign.markdown({**s, "cases": 6, "seed": 0, "record_s": 6.0, "where": "here", "wall_s": 60.0,
                               "command": "c"})
     assert "| null cases | 2 | 22 | 30 |" in text and "| pairs | 3 | 240 | 360 |" in text
+    assert "Left out" not in text
+
+
+def test_the_time_per_case_leaves_out_cases_diagnosed_again_from_stored_fits():
+    """A case whose outcome was removed to diagnose it again reads its stored fits: its time is not a diagnosis's
+    from scratch, so neither the median nor the table holds it."""
+    spent = [("hysteresis", 40.0, False), ("hysteresis", 4.0, True), ("cubic_stiffness", 60.0, False)]
+    outcomes = [{"withheld": w, "named": "none", "enr": 10.0, "top_shrink_pct": None, "stated": None,
+                 "data_s": 0.0, "diagnose_s": t, "verdict": "", "fits_reused": r} for w, t, r in spent]
+    s = campaign.summarise(outcomes)
+    assert s["fits_reused"] == 1 and s["median_case_s"] == 50.0
+    assert s["times"][1] == {"kind": "single effects", "cases": 2, "median_s": 50.0, "longest_s": 60.0}
+    text = campaign.markdown({**s, "cases": 3, "seed": 0, "record_s": 6.0, "where": "here", "wall_s": 60.0,
+                              "command": "c"})
+    assert "median 50 s per case diagnosed from scratch" in text
+    assert "Left out: the 1 case diagnosed again from the fits an earlier run stored" in text
 
 
 def test_the_summary_bins_cases_by_their_weakest_withheld_effect():
@@ -243,6 +259,10 @@ def test_a_short_campaign_on_a_local_dask_cluster(tmp_path, fmu_dir, measured):
     assert time.perf_counter() - t0 < 0.5 * summary["wall_s"]
     assert summary["resumed"] == 0 and again["resumed"] == 19 and again["wall_s"] < 0.5 * summary["wall_s"]
     assert again["earlier_wall_s"] == summary["wall_s"]  # a full run's wall time at most the two runs'
+    # the redone case read the fits its first run stored: its time is left out of the time per case
+    assert summary["fits_reused"] == 0 and again["fits_reused"] == 1
+    assert sum(t["cases"] for t in again["times"]) == 19 == sum(t["cases"] for t in summary["times"]) - 1
+    assert "Left out: the 1 case diagnosed again from the fits" in (tmp_path / "summary.md").read_text()
     assert (f"(19 read from an earlier run, whose runs took {summary['wall_s'] / 60:.1f} min: a full run takes at "
             f"most {(summary['wall_s'] + again['wall_s']) / 60:.1f} min)") in (tmp_path / "summary.md").read_text()
     whole = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)  # every case stored: summarised
