@@ -148,12 +148,15 @@ def test_the_summary_times_nulls_singles_and_pairs_apart():
     outcomes = [{"withheld": w, "named": "none", "enr": 10.0, "top_shrink_pct": None, "stated": None,
                  "data_s": d, "diagnose_s": t, "verdict": ""} for w, t, d in spent]
     s = campaign.summarise(outcomes)
-    assert s["times"] == [{"kind": "null cases", "cases": 2, "median_s": 22.5, "longest_s": 30.0},
-                          {"kind": "single effects", "cases": 1, "median_s": 60.0, "longest_s": 60.0},
-                          {"kind": "pairs", "cases": 3, "median_s": 240.0, "longest_s": 360.0}]
+    assert s["times"] == [{"kind": "null cases", "cases": 2, "median_s": 22.5, "longest_s": 30.0,
+                           "diagnose_median_s": 15.0, "diagnose_longest_s": 20.0},
+                          {"kind": "single effects", "cases": 1, "median_s": 60.0, "longest_s": 60.0,
+                           "diagnose_median_s": 40.0, "diagnose_longest_s": 40.0},
+                          {"kind": "pairs", "cases": 3, "median_s": 240.0, "longest_s": 360.0,
+                           "diagnose_median_s": 200.0, "diagnose_longest_s": 300.0}]
     text = campaign.markdown({**s, "cases": 6, "seed": 0, "record_s": 6.0, "where": "here", "wall_s": 60.0,
                               "command": "c"})
-    assert "| null cases | 2 | 22 | 30 |" in text and "| pairs | 3 | 240 | 360 |" in text
+    assert "| null cases | 2 | 22 | 30 | 15 | 20 |" in text and "| pairs | 3 | 240 | 360 | 200 | 300 |" in text
     assert "Left out" not in text
 
 
@@ -165,7 +168,8 @@ def test_the_time_per_case_leaves_out_cases_diagnosed_again_from_stored_fits():
                  "data_s": 0.0, "diagnose_s": t, "verdict": "", "fits_reused": r} for w, t, r in spent]
     s = campaign.summarise(outcomes)
     assert s["fits_reused"] == 1 and s["median_case_s"] == 50.0
-    assert s["times"][1] == {"kind": "single effects", "cases": 2, "median_s": 50.0, "longest_s": 60.0}
+    assert s["times"][1] == {"kind": "single effects", "cases": 2, "median_s": 50.0, "longest_s": 60.0,
+                             "diagnose_median_s": 50.0, "diagnose_longest_s": 60.0}
     text = campaign.markdown({**s, "cases": 3, "seed": 0, "record_s": 6.0, "where": "here", "wall_s": 60.0,
                               "command": "c"})
     assert "median 50 s per case diagnosed from scratch" in text
