@@ -1,5 +1,6 @@
 """The `stockbridge` command: every job is a subcommand with its own help and an example; the scripts are
 the same commands; bad arguments give one clear error."""
+import os
 import pathlib
 import shutil
 import subprocess
@@ -47,3 +48,25 @@ def test_bad_arguments_give_one_clear_error(tmp_path):
     assert res.returncode == 2 and "nowhere" in res.stderr and "Traceback" not in res.stderr
     res = run(sys.executable, "-m", "pyfit.cli", "simulate", "SDOFBoucWen", "--set", "beta=abc")
     assert res.returncode == 2 and "--set takes NAME=VALUE with a numeric VALUE" in res.stderr
+    for job, arg, value in (("diagnose", "--campaign", "0"), ("diagnose", "--workers", "-2"), ("fit", "--repeats", "x")):
+        res = run(sys.executable, "-m", "pyfit.cli", job, arg, value)
+        assert res.returncode == 2 and f"argument {arg}: '{value}': a whole number of at least 1" in res.stderr
+    res = run(sys.executable, "-m", "pyfit.cli", "diagnose", "--model", "sdfo", "--data", str(tmp_path))
+    assert res.returncode == 2 and "invalid choice: 'sdfo' (choose from 'sdof', 'damper')" in res.stderr
+
+
+def test_the_model_choices_are_the_system_families():
+    from pyfit.cli.diagnose import MODELS
+    from pyfit.gap.systems import FAMILY
+
+    assert set(MODELS) == set(FAMILY)
+
+
+def test_a_scheduler_that_does_not_answer_gives_one_clear_error(tmp_path):
+    """No Dask scheduler at the address: one error naming it and what to do, not a traceback (the wait for an
+    answer shortened from Dask's 30 s)."""
+    res = subprocess.run([sys.executable, "-m", "pyfit.cli", "diagnose", "--campaign", "2", "--out", str(tmp_path),
+                          "--scheduler", "tcp://127.0.0.1:9"], capture_output=True, text=True, timeout=120,
+                         env={**os.environ, "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "2s"})
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    assert "error: no Dask scheduler answered at tcp://127.0.0.1:9" in res.stderr and "dask scheduler" in res.stderr

@@ -24,6 +24,17 @@ COMMANDS = {
 }
 
 
+def count(text: str) -> int:
+    """An argparse type: a whole number of at least 1 (cases, workers, repeats)."""
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: a whole number of at least 1 is needed")
+    return n
+
+
 def parser() -> argparse.ArgumentParser:
     """The top-level parser with every subcommand (each adds its own arguments when it is chosen)."""
     ap = argparse.ArgumentParser(prog="stockbridge", description="Stockbridge damper and Bouc-Wen models as "

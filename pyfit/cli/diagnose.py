@@ -6,6 +6,10 @@ import json
 import pathlib
 import sys
 
+from pyfit.cli import count
+
+MODELS = ("sdof", "damper")  # the system families (pyfit.gap.systems.FAMILY), named here to keep start-up light
+
 EXAMPLE = """examples:
   stockbridge diagnose --model damper --data my_sweeps/ --nominal my_damper.toml --out results/diagnose
   stockbridge diagnose --model sdof --data my_tests/
@@ -23,7 +27,8 @@ Writes report.md (verdict, ranked effects, shrink on held-out files), report.jso
 
 def add_arguments(ap) -> None:
     """Arguments of `stockbridge diagnose`."""
-    ap.add_argument("--model", default="sdof", help="nominal model: sdof (linear SDOF) or damper (linear FE damper)")
+    ap.add_argument("--model", default="sdof", choices=MODELS,
+                    help="nominal model: sdof (linear SDOF) or damper (linear FE damper)")
     ap.add_argument("--data", help="dataset folder (CSV + TOML pairs)")
     ap.add_argument("--config", help="TOML with a [diagnose] table")
     ap.add_argument("--nominal", help="TOML describing your system: [nominal] family, fixed and free parameters "
@@ -31,7 +36,7 @@ def add_arguments(ap) -> None:
     ap.add_argument("--candidates", help="TOML declaring your own candidate effects (FMU parameters, bounds, start "
                                          "rules) and the FMU that holds them; docs: gap diagnosis")
     ap.add_argument("--out", default="results/diagnose")
-    ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument("--workers", type=count, default=None)
     ap.add_argument("--fmus", default="fmus")
     ap.add_argument("--make-datasets", metavar="DIR", help="write the withheld-effect datasets of --model into DIR")
     ap.add_argument("--benchmark", action="store_true",
@@ -47,7 +52,7 @@ def add_arguments(ap) -> None:
                     "stepped sine (sdof) or band-limited noise from rest, or (--model damper) an impedance test")
     ap.add_argument("--record", nargs="+", metavar="OUTPUT", help="with --make-datasets: the outputs recorded "
                     "(default: displacements; e.g. a, or acc_x1 acc_x2)")
-    ap.add_argument("--campaign", type=int, metavar="N", help="validation campaign: draw N random cases of --model "
+    ap.add_argument("--campaign", type=count, metavar="N", help="validation campaign: draw N random cases of --model "
                     "(effects, pairs, nulls; strengths, loop shapes, excitation, sensors; a damper's geometry), "
                     "write and diagnose each, summarise (confusion matrix, detection limit, false alarms) in "
                     "OUT/summary.md; resumes")
@@ -97,7 +102,7 @@ def run(args, ap) -> int:
                 ap.error("--data is required (or --impedance, --benchmark, --make-datasets, --cases)")
             report = diagnose(args.model, args.data, args.out, cfg, args.fmus, args.workers, nominal=args.nominal,
                               candidates=args.candidates)
-    except (ConfigError, ValueError, FileNotFoundError) as exc:
+    except (ConfigError, ValueError, OSError) as exc:  # OSError: a file not found, a scheduler not answering
         print(f"error: {exc}", file=sys.stderr)
         return 2
     print(json.dumps({k: report[k] for k in ("verdict", "chosen_effect")}, indent=1))

@@ -5,6 +5,7 @@ import pathlib
 import sys
 
 from pyfit.catalog import CONFIGS
+from pyfit.cli import count
 
 DEFAULT = CONFIGS / "quickstart.toml"
 EXAMPLE = """examples:
@@ -19,8 +20,8 @@ with figures, and <out>/summary.md."""
 def add_arguments(ap) -> None:
     """Arguments of `stockbridge fit`."""
     ap.add_argument("configs", nargs="*", help=f"fit study files (default: the bundled {DEFAULT.name})")
-    ap.add_argument("--repeats", type=int, default=1, help="seeds per config")
-    ap.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    ap.add_argument("--repeats", type=count, default=1, help="seeds per config")
+    ap.add_argument("--workers", type=count, help="local worker processes (default: one per core)")
     ap.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
     ap.add_argument("--out", default="results/fit", help="output folder")
     ap.add_argument("--fmus", default="fmus", help="folder with the FMUs (built if missing)")
@@ -37,7 +38,7 @@ def run(args, ap) -> int:
     try:
         results = fit_batch(configs, args.repeats, pathlib.Path(args.out), pathlib.Path(args.fmus), args.workers,
                             args.scheduler, nominal=load_nominal(args.nominal) if args.nominal else None)
-    except (ConfigError, FileNotFoundError) as exc:
+    except (ConfigError, OSError) as exc:  # OSError: a file not found, a scheduler not answering
         print(f"error: {exc}", file=sys.stderr)
         return 2
     failed = [r for r in results if "error" in r]

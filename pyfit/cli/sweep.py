@@ -4,6 +4,8 @@ from __future__ import annotations
 import pathlib
 import sys
 
+from pyfit.cli import count
+
 EXAMPLE = """examples:
   stockbridge sweep configs/seed_fig4_4_sweep.toml --out results/sweep
   stockbridge sweep study.toml --scheduler tcp://10.0.0.5:8786"""
@@ -13,7 +15,7 @@ def add_arguments(ap) -> None:
     """Arguments of `stockbridge sweep`."""
     ap.add_argument("config")
     ap.add_argument("--out", help="output folder (default: results/<config stem>)")
-    ap.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    ap.add_argument("--workers", type=count, help="local worker processes (default: one per core)")
     ap.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
     ap.add_argument("--fmus", default="fmus", help="folder with the FMUs (built if missing)")
     ap.add_argument("--nominal", help="TOML describing your system ([nominal] fixed and free parameters)")
@@ -32,7 +34,7 @@ def run(args, ap) -> int:
                          load_nominal(args.nominal) if args.nominal else None)
         out = pathlib.Path(args.out or f"results/{cfg.path.stem}")
         rows = run_study(cfg, fmus, out, args.workers, args.scheduler)
-    except (ConfigError, ValueError) as exc:
+    except (ConfigError, ValueError, ConnectionError) as exc:  # ConnectionError: a scheduler not answering
         print(f"error: {exc}", file=sys.stderr)
         return 2
     failed = [r for r in rows if not r["ok"]]

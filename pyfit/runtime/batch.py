@@ -62,6 +62,18 @@ def _progress(total, enabled, desc):
     return tqdm(total=total, disable=not enabled, desc=desc, unit="run")
 
 
+def _connect(address: str):
+    """A Dask client of the scheduler at `address`; ConnectionError naming it when none answers."""
+    from distributed import Client
+
+    try:
+        return Client(address)
+    except (OSError, ValueError) as exc:  # nothing listening, a timeout, or an address Dask cannot parse
+        raise ConnectionError(f"no Dask scheduler answered at {address} ({exc}): start one (`dask scheduler`, "
+                              f"then `dask worker {address}` on each machine), or give no scheduler address to run "
+                              "on this machine's cores") from exc
+
+
 def map_tasks(fn, items: list, workers: int | None = None, scheduler=None, progress: bool = True,
               desc: str = "tasks") -> list:
     """fn(item) for every item, results in order: serially (workers=1), on a local process pool
@@ -74,7 +86,7 @@ def map_tasks(fn, items: list, workers: int | None = None, scheduler=None, progr
         if scheduler is not None:
             from distributed import Client, as_completed
 
-            client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
+            client = scheduler if isinstance(scheduler, Client) else _connect(scheduler)
             futures = {client.submit(fn, it, pure=False): i for i, it in enumerate(items)}
             for fut in as_completed(futures):
                 results[futures[fut]] = fut.result()
