@@ -49,8 +49,9 @@ def test_an_envelope_fit_minimises_the_envelopes_misfit(tmp_path, sdof_system, m
 
 @pytest.mark.slow  # a whole damper diagnosis (about 3 min on 2 cores)
 def test_a_strong_spring_and_loop_on_a_sweep_are_named_from_the_envelopes(tmp_path, fmu_dir, measured):
-    """Damper campaign case 24 (seed 0): cubic springs and a Bouc-Wen loop, each several hundred times the
-    noise, on 6 s clamp sweeps of a random catalogue damper. The waveform refits of every single effect and
+    """Damper campaign case 24 (seed 0), its truth as drawn (unscaled: the campaign scales each effect to its
+    drawn size over the noise): cubic springs and a Bouc-Wen loop, each several hundred times the noise, on 6 s
+    clamp sweeps of a random catalogue damper. The waveform refits of every single effect and
     pair ended a cycle off (best held-out shrink 6 %, "not explained"); from the envelopes the pair is named."""
     case = campaign.draw(30, 0, "damper")[24]
     assert case.withheld == "cubic_stiffness+hysteresis" and case.excitation == "sweep"

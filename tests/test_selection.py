@@ -67,7 +67,7 @@ def test_of_two_single_effects_within_the_noise_a_linear_change_wins_on_its_misf
 
 
 def test_of_two_pairs_within_the_noise_but_far_apart_the_lower_misfit_is_kept():
-    """Damper campaign case 4 (stockbridge diagnose --campaign 30 --model damper; Coulomb friction with a weak loop
+    """Damper campaign case 4 (stockbridge diagnose --campaign 100 --model damper; Coulomb friction with a weak loop
     withheld; floor should the noise grow 0.0133, so both pairs lie under its 1.2x): the true pair (9 parameters)
     leaves 0.00648 on the held-out files, friction with a mass eccentricity (5) 0.00785, 21 % more. On the same
     files that difference is the data telling the models apart, so the lower misfit is kept in either order;

@@ -85,7 +85,7 @@ RESULTS = {
                                            "configs/diagnose_nominal_threshold.toml --calibrate --out "
                                            "results/campaign_threshold"),
     "docs/results/campaign_damper.md": ("results/campaign_damper/summary.md",
-                                        "stockbridge diagnose --campaign 30 --model damper --out "
+                                        "stockbridge diagnose --campaign 100 --model damper --out "
                                         "results/campaign_damper"),
     "docs/results/campaign_damper_calibration.md": ("results/campaign_damper_calibration/summary.md",
                                                     "stockbridge diagnose --campaign 100 --campaign-seed 1 --model "
