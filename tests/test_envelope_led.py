@@ -34,7 +34,7 @@ def test_an_envelope_fit_minimises_the_envelopes_misfit(tmp_path, sdof_system, m
                                   truth={"k3": float(rng.uniform(5e7, 2e8))},
                                   style=datasets.LabStyle("sweep", ("y",), record_s=6.0))
     cfg = dg.with_family_drive(dg.DiagnoseConfig(), "sdof")
-    _, cal, *_ = dg._load(data, system, cfg, runner)
+    cal = dg._load(data, system, cfg, runner).cal
     nominal = run_fit(nominal_task(system, runner.path, cal, 30, cfg.upsample))
     moved = [sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods,
                           outputs=system.deflection_outputs) for r in cal]

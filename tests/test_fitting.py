@@ -2,6 +2,7 @@
 import dataclasses
 import json
 import pathlib
+import re
 import shutil
 import textwrap
 
@@ -169,6 +170,25 @@ patience = 40
 [report]
 truth = { alpha = 50000.0 }
 """
+
+
+def test_a_fit_target_channel_in_another_quantity_is_refused(tmp_path, fmu_dir):
+    """The fit's bounds and fixed values are SI: a displacement column declared in N (or in V) is refused before
+    any simulation, naming the sidecar's field and the units of a length."""
+    from pyfit.fit.fitting import ensure_target, open_objectives
+
+    cfg_path = tmp_path / "tiny.toml"
+    cfg_path.write_text(TINY)
+    cfg = load_fit(cfg_path)
+    ensure_target(cfg)
+    side = cfg.target_file.with_suffix(".toml")
+    written = side.read_text()
+    for unit, quantity in (("N", "force"), ("V", "voltage")):
+        side.write_text(re.sub(r'(y_meas = \{ unit = )"m"', rf'\1"{unit}"', written))
+        with pytest.raises(MeasurementError) as err:
+            open_objectives(cfg, fmu_dir)
+        assert f"[outputs.y_meas.unit] '{unit}' measures {quantity}; model_variable 'y' is length (m)" in str(
+            err.value) and "allowed: m, mm, um" in str(err.value), str(err.value)
 
 
 def test_fit_batch_writes_results_and_resumes_without_redoing(tmp_path, fmu_dir):

@@ -52,7 +52,7 @@ def test_a_refit_is_the_same_on_one_thread_as_on_two(data_root, sdof_system, mon
 
     runner, system = sdof_system
     fmu = runner.path
-    _, cal, _, _, _, _ = dg._load(case(data_root, "cubic_stiffness"), system, CI, runner)
+    cal = dg._load(case(data_root, "cubic_stiffness"), system, CI, runner).cal
     assert len(cal) >= 2  # two records to simulate at once
     one, two = (dg.run_fit(nominal_task(system, fmu, cal, 12, system.upsample, threads=n)) for n in (1, 2))
     assert one.params == two.params and one.calibration_nrmse == two.calibration_nrmse

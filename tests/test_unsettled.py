@@ -71,13 +71,14 @@ def test_the_diagnosis_splits_the_other_files_and_says_why(tmp_path, sdof_system
                                   periods=2)
     files = sorted(data.glob("*.csv"))  # level1_10N, level2_25N, level3_50N
     not_repeating(files[2], rng.uniform(0.2, 0.5), rng)
-    records, cal, held, _, _, aside = dg._load(data, sdof, CI, runner)
+    loaded = dg._load(data, sdof, CI, runner)
+    records, cal, held, aside = loaded.records, loaded.cal, loaded.held, loaded.aside
     assert list(aside) == [files[2].stem] and aside[files[2].stem][0] > 0.15
     assert [r.name for r in cal] == [files[0].stem] and [r.name for r in held] == [files[1].stem]
     assert files[2].stem not in [r.name for r in records]
     # files the user names to calibrate on are the user's: nothing is set aside
     named = dg.DiagnoseConfig(calibration=[files[0].stem, files[2].stem])
-    assert dg._load(data, sdof, named, runner)[5] == {}
+    assert dg._load(data, sdof, named, runner).aside == {}
     not_repeating(files[1], 0.3, rng)  # two of three files unsettled: one error naming both
     with pytest.raises(dg.DiagnoseError, match=f"{files[1].stem}, {files[2].stem} does not repeat"):
         dg._load(data, sdof, CI, runner)

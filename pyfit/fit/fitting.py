@@ -8,13 +8,14 @@ import pathlib
 from dataclasses import asdict
 
 import numpy as np
+from fmpy import read_model_description
 
 from pyfit import __version__
 from pyfit.analysis import signals
 from pyfit.report import plots
 from pyfit.io import benchmark_data
 from pyfit.runtime.benchmark_runs import simulate_validation
-from pyfit.io.data import read_measurement
+from pyfit.io.data import check_quantities, read_measurement
 from pyfit.io.fit_config import FitConfig
 from pyfit.io.impedance import read_impedance
 from pyfit.fit.impedance_objective import ImpedanceObjective
@@ -113,6 +114,9 @@ def open_objectives(cfg: FitConfig, fmu_dir: pathlib.Path):
     fmu = ensure_fmu(cfg.model, fmu_dir)
     impedance = cfg.objective_kind == "impedance"
     measurement = read_impedance(cfg.target_file) if impedance else read_measurement(cfg.target_file)
+    if not impedance:  # the bounds and fixed values are SI: every channel in its model variable's quantity
+        units = {v.name: v.unit or "" for v in read_model_description(str(fmu)).modelVariables}
+        check_quantities(measurement, units, voltages=False)
     objectives = {}
 
     def objective_of(kind: str):

@@ -16,7 +16,7 @@ import threadpoolctl
 
 from pyfit.runtime.batch import map_tasks
 from pyfit.runtime.clock import StageClock
-from pyfit.io.data import MeasurementError, read_dataset_with_order
+from pyfit.io.data import QUANTITY, MeasurementError, check_quantities, read_dataset_with_order
 from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
 from pyfit.runtime.examples import ensure_fmu
@@ -90,13 +90,26 @@ def load_config(path) -> DiagnoseConfig:
     return cfg
 
 
-def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
-    """Records of the dataset, validated against the FMU's variables, split into calibration and held-out; the
-    data's digest, what the level order rests on (pyfit.io.data.level_order) and the records the default split
-    set aside (localise.unsettled: name -> its period scatter and the lowest noise floor of a lower level)."""
+@dataclass(frozen=True)
+class Dataset:
+    """A dataset as the diagnosis reads it (_load)."""
+
+    records: list  # every record, in level order (pyfit.gap.simulate.Record)
+    cal: list  # the records calibrated on
+    held: list  # the records held out
+    key: str  # the data's digest
+    order: str  # what the level order rests on (pyfit.io.data.level_order)
+    aside: dict  # records the default split set aside (localise.unsettled: name -> period scatter, lower floor)
+    voltages: list  # 'column (model_variable)' of each channel recorded as a voltage (System.gains_free)
+
+
+def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
+    """Records of the dataset, validated against the FMU's variables and their units, split into calibration
+    and held-out."""
     data_dir = pathlib.Path(data_dir)
     md_vars = runner.model_description.modelVariables
     variables = {v.name for v in md_vars}
+    units = {v.name: v.unit or "" for v in md_vars}
     allowed = {"inputs": [v.name for v in md_vars if v.causality == "input"],
                "outputs": [v.name for v in md_vars if v.causality == "output"]}
     try:
@@ -116,6 +129,13 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
         if abs(m.sample_rate_hz - ms[0].sample_rate_hz) > 1e-6 * ms[0].sample_rate_hz:
             raise DiagnoseError(f"{m.path.with_suffix('.toml')}: sample_rate_hz = {m.sample_rate_hz:g} but "
                                 f"{ms[0].path.name} has {ms[0].sample_rate_hz:g}; a dataset needs one rate")
+        try:
+            check_quantities(m, units, system.gains_free)
+        except MeasurementError as exc:
+            raise DiagnoseError(str(exc)) from exc
+    voltages = sorted({f"{ch.column} ({ch.model_variable})" for m in ms for ch in [*m.inputs.values(),
+                                                                                 *m.outputs.values()]
+                       if QUANTITY[ch.unit] == "voltage"})
     unknown = [e for e in (cfg.effects or []) if e not in system.effects]
     if unknown:
         raise DiagnoseError(f"effects: '{unknown[0]}' unknown for {system.name}; allowed: "
@@ -155,7 +175,7 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner):
     for m in ms:
         digest.update(m.path.read_bytes())
         digest.update(m.path.with_suffix(".toml").read_bytes())
-    return records, cal, held, digest.hexdigest()[:16], order, aside
+    return Dataset(records, cal, held, digest.hexdigest()[:16], order, aside, voltages)
 
 
 def _simulated(runner, records, values: dict, system, cfg: DiagnoseConfig) -> dict:
@@ -735,7 +755,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     if users:
         system = _with_user_candidates(system, users, set(runner.parameter_names()))
     cfg = with_family_drive(cfg, model)
-    records, cal, held, data_key, level_order, aside = _load(data_dir, system, cfg, runner)
+    data = _load(data_dir, system, cfg, runner)
+    records, cal, held, data_key = data.records, data.cal, data.held, data.key
     lo, hi = localise.excited_range(records)
     modes = linear_modes(fmu, {**system.nominal_fixed, **system.start(cal)})
 
@@ -830,8 +851,9 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         clock.end("combinations of effects")
     result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
                              selected)
-    result["level_order"] = level_order
-    result["set_aside"] = {name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in aside.items()}
+    result["level_order"] = data.order
+    result["set_aside"] = {name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in data.aside.items()}
+    result["voltage_channels"] = data.voltages
     top = result["ranking"][0]["shrink_pct"] if result["ranking"] else None
     calibration = confidence.load(confidence.settings_of(asdict(cfg)), model)
     result["confidence"] = confidence.stated(result["verdict"], result["chosen_effect"], top, calibration)
@@ -863,7 +885,8 @@ def misfit_at(model: str, data_dir, params: dict, cfg: DiagnoseConfig | None = N
         system = make_system(model, fmu_defaults(runner),
                              load_nominal(nominal) if isinstance(nominal, (str, pathlib.Path)) else nominal)
         cfg = with_family_drive(cfg, model)
-        _, cal, held, *_ = _load(data_dir, system, cfg, runner)
+        data = _load(data_dir, system, cfg, runner)
+        cal, held = data.cal, data.held
         values = {**system.nominal_fixed, **params}
         return SplitMisfit(*(selection.heldout_nrmse(_simulated(runner, files, values, system, cfg), files)
                              for files in (held, cal)))

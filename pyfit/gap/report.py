@@ -395,6 +395,16 @@ def _set_aside_lines(aside: dict) -> list[str]:
             "it would pull every parameter off).\n" for name, d in aside.items()]
 
 
+def _voltage_lines(channels: list[str]) -> list[str]:
+    """What a voltage channel (pyfit.io.data.check_quantities) means for the fitted values."""
+    if not channels:
+        return []
+    return [f"Recorded as voltages: {', '.join(channels)}: read in the model's units with a gain nobody measured "
+            "(N/V of a drive, V/m of a sensor). The verdict does not depend on it; every fitted mass, damping, "
+            "stiffness and effect strength carries it, the natural frequency sqrt(k/m) and the damping ratio do "
+            "not.", ""]
+
+
 def markdown(result: dict) -> str:
     """The report as markdown (tables, evidence, figures)."""
     g = result["gap"]
@@ -405,7 +415,8 @@ def markdown(result: dict) -> str:
     lines += [
         f"Calibrated on {', '.join(result['calibration_files'])}; held out: "
         f"{', '.join(result['held_out_files'])}. Levels ordered by {result['level_order']}.",
-        ""] + _set_aside_lines(result.get("set_aside", {})) + [
+        ""] + _set_aside_lines(result.get("set_aside", {})) + _voltage_lines(result.get("voltage_channels", []))
+    lines += [
         f"Held-out gap (NRMSE) of the nominal model: **{g['overall']:.4f}**; noise floor from the data: "
         f"{g['noise_floor']:.4f} ({', '.join(g.get('noise_floor_method', []))}){_scaled_floor(g)}; nominal "
         f"calibration NRMSE {result['nominal']['calibration_nrmse']:.4f}. An effect explains the gap when the held-out NRMSE with "

@@ -133,6 +133,8 @@ class System:
     damping: tuple = ()  # the damping parameters among `linear` the nominal's damping scan scales together
     upsample: int = 4  # the FMU's drive grid = the sensor rate x this (DiagnoseConfig.upsample overrides it)
     smooth_inputs: bool = False  # drive the FMU with the inputs' cubic spline (pyfit.runtime.drive), not lines
+    gains_free: bool = False  # every parameter is fitted from the data (a family that starts from the data, none
+    # described): a channel's unknown gain (a voltage read in the model's unit) rescales them and no verdict
 
 
 def combine(effects: list[Effect]) -> Effect:
@@ -575,4 +577,5 @@ def make_system(name: str, defaults: dict, nominal=None) -> System:
 
     return System(name, fam.fmu, {**fam.switches, **fixed}, linear, fam.stiffness, start, data_starts, bounds,
                   scale, fam.effects, fam.lead_periods, fam.deflection_outputs, fam.motion_inputs, fam.deflection,
-                  tuple(n for n in fam.damping if n in linear), fam.upsample, fam.smooth_inputs)
+                  tuple(n for n in fam.damping if n in linear), fam.upsample, fam.smooth_inputs,
+                  fam.data_start is not None and not fixed)

@@ -11,7 +11,10 @@ The reader takes files as lab software writes them, wherever that is still unamb
 - unit spellings: `[mm]`, `m/s^2`, `m/s²`, `µm`, `μm` are the same as mm, m/s2, um;
 - a time column rounded to as few as 6 significant digits, or none at all (then sample_rate_hz gives the
   time); the samples are put on the exact grid t0 + k/fs;
-- units converted to SI on reading (see TO_SI).
+- units converted to SI on reading (see TO_SI); a voltage (V, mV) is read as the model's own unit: a signal
+  proportional to the model variable with a gain nobody measured (a shaker's drive voltage for its force, an
+  electronic oscillator's node voltage), which a model whose every parameter is fitted takes up
+  (check_quantities says where it may stand).
 and refuses, with one error naming file, row and value, what is not: a gap, a repeated or decreasing
 time, a time column that disagrees with sample_rate_hz by more than MAX_TIME_SLIP samples, `;`
 separators or decimal commas, columns separated by spaces, a units row that contradicts the sidecar,
@@ -30,7 +33,10 @@ import numpy as np
 from pyfit.io.schema import ConfigError, check_table, fail, read_text, read_toml
 
 TO_SI = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "rad": 1.0, "deg": np.pi / 180, "m/s": 1.0, "mm/s": 1e-3,
-         "m/s2": 1.0, "mm/s2": 1e-3, "g": 9.80665, "N": 1.0, "kN": 1e3}
+         "m/s2": 1.0, "mm/s2": 1e-3, "g": 9.80665, "N": 1.0, "kN": 1e3, "V": 1.0, "mV": 1e-3}
+QUANTITY = {"m": "length", "mm": "length", "um": "length", "rad": "angle", "deg": "angle", "m/s": "velocity",
+            "mm/s": "velocity", "m/s2": "acceleration", "mm/s2": "acceleration", "g": "acceleration",
+            "N": "force", "kN": "force", "V": "voltage", "mV": "voltage"}  # of each unit of TO_SI
 TIME_UNITS = {"s": 1.0, "ms": 1e-3}
 MAX_ABS_SI = 1e100  # largest magnitude of a measured value in SI units: its square over a million samples,
 #                      and its derivatives at MHz rates, stay far inside double precision (1.8e308)
@@ -354,6 +360,25 @@ def read_dataset(folder: str | pathlib.Path) -> list[Measurement]:
     return read_dataset_with_order(folder)[0]
 
 
+def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool) -> None:
+    """Check that each channel's unit measures its model variable's quantity (model_units: variable -> the
+    model's unit, e.g. 'N' from the FMU), or, where `voltages`, is a voltage proportional to it (read in the
+    model's unit, its gain unknown: every parameter the model fits then carries that gain). Raises
+    MeasurementError naming the sidecar's field and the units allowed."""
+    side = m.path.with_suffix(".toml")
+    for section, channels in (("inputs", m.inputs), ("outputs", m.outputs)):
+        for col, ch in channels.items():
+            unit = unit_key(model_units.get(ch.model_variable, ""))
+            want, got = QUANTITY.get(unit), QUANTITY[ch.unit]
+            if want is None or got == want or (voltages and got == "voltage"):
+                continue
+            allowed = [u for u, q in QUANTITY.items() if q == want or (voltages and q == "voltage")]
+            why = (" (a voltage stands for it only where every model parameter is fitted: convert it with the "
+                   "sensor's sensitivity)" if got == "voltage" else "")
+            fail(side, f"{section}.{col}.unit", f"'{ch.unit}' measures {got}; model_variable "
+                 f"'{ch.model_variable}' is {want} ({unit}){why}", ", ".join(allowed), MeasurementError)
+
+
 def read_dataset_with_order(folder: str | pathlib.Path) -> tuple[list[Measurement], str]:
     """All measurements in a folder, ordered by level, and what the order rests on."""
     folder = pathlib.Path(folder)
@@ -365,5 +390,5 @@ def read_dataset_with_order(folder: str | pathlib.Path) -> tuple[list[Measuremen
     return level_order(items)
 
 
-__all__ = ["Channel", "Measurement", "MeasurementError", "TO_SI", "level_order", "read_dataset", "unit_key",
-           "read_dataset_with_order", "read_measurement", "write_measurement"]
+__all__ = ["Channel", "Measurement", "MeasurementError", "QUANTITY", "TO_SI", "check_quantities", "level_order",
+           "read_dataset", "read_dataset_with_order", "read_measurement", "unit_key", "write_measurement"]
