@@ -2,6 +2,7 @@
 the local polynomial method against the known sensor noise of a simulated record, and the dataset rule
 that sensor noise does not grow with the level while nonlinear distortion does."""
 import numpy as np
+import pytest
 import scipy.signal as ss
 
 from pyfit.gap import localise
@@ -152,3 +153,25 @@ def test_the_input_sensors_noise_alone_seldom_ends_a_rest_early(measured):
     assert max(rests) == 19 * 16
     measured("rest of 20 windows of input noise before a sine, ended early by the noise: share of records",
              np.mean(np.array(rests) < 19 * 16), 0.02)
+
+
+
+def test_the_where_bands_of_a_sweep_from_0_hz_hold_its_resonance_and_the_octaves_below_it():
+    """A 0-40 Hz linear sweep excites down to a fraction of a hertz: the default bands start at the top / BAND_SPAN
+    (not at that fraction), log-spaced, so the 21 Hz resonance has four bands below it; a 5-40 Hz sweep keeps
+    its bands from 0.8 x its lowest excited line."""
+    fs, T = 1024.0, 20.0
+    t = np.arange(int(T * fs)) / fs
+    br, ar = ss.iirpeak(21.0 / (fs / 2), 30)
+    bands, lowest = {}, {}
+    for f0 in (0.0, 5.0):
+        u = np.clip(t / 0.5, 0, 1) * np.sin(2 * np.pi * (f0 * t + (40.0 - f0) / (2 * T) * t**2))
+        recs = [Record(f"r{j}", "", j, fs, {"u": a * u}, {"y": ss.lfilter(br, ar, a * u)}, 0) for j, a in
+                enumerate((1.0, 2.0))]
+        bands[f0], lowest[f0] = localise.default_bands(recs), localise.excited_range(recs)[0]
+    top = bands[0.0][-1][1]
+    assert lowest[0.0] < 0.5 and 1.2 * 40.0 <= top <= 1.2 * 42.0
+    assert bands[0.0][0][0] == pytest.approx(top / localise.BAND_SPAN, rel=1e-12)
+    assert np.allclose([b / a for a, b in bands[0.0]], localise.BAND_SPAN ** (1 / 8))
+    assert sum(a <= 21.0 <= b for a, b in bands[0.0]) == 1 and bands[0.0][3][1] < 21.0
+    assert 4.0 < bands[5.0][0][0] == pytest.approx(0.8 * lowest[5.0], rel=1e-12)

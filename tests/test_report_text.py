@@ -2,7 +2,7 @@
 what a gap no candidate explains is told with."""
 from pyfit.gap.diagnose import DiagnoseConfig
 from pyfit.gap.report import LISTED_IN_FULL, POOR_LINEAR_NRMSE, not_explained_lines, starts_text
-from pyfit.gap.systems import SDOF_EFFECTS, Scale
+from pyfit.gap.systems import FAMILY, SDOF_EFFECTS, Scale
 
 
 def test_a_few_starts_are_written_one_by_one():
@@ -26,7 +26,8 @@ def test_many_starts_are_summarised_by_parameter():
 def _unexplained(best_calibration_nrmse: float, shrinks: dict) -> list[str]:
     ranking = [{"effect": n, "shrink_pct": v, "heldout_gap_after": 0.5} for n, v in shrinks.items()]
     gap = {"noise_floor": 0.01, "worst_band_hz": (4.7, 6.1)}
-    return not_explained_lines(ranking[0], ranking, gap, (best_calibration_nrmse, "level1"), 0.05, DiagnoseConfig())
+    return not_explained_lines(ranking[0], ranking, gap, (best_calibration_nrmse, "level1"), 0.05, DiagnoseConfig(),
+                               FAMILY["sdof"].outside)
 
 
 def test_a_nominal_that_misfits_every_file_and_refits_that_remove_little_are_said_first():
@@ -40,3 +41,12 @@ def test_a_nominal_that_misfits_every_file_and_refits_that_remove_little_are_sai
     assert lines[1].startswith("best candidate sensor_delay")
     assert len(_unexplained(POOR_LINEAR_NRMSE * 0.99, {"sensor_delay": 12.1})) == 3
     assert len(_unexplained(0.702, {"cubic_stiffness": required + 1.0})) == 3
+
+
+def test_the_effects_outside_the_candidates_named_are_the_family_s():
+    """The hint of an unexplained gap names effects common in that family and how to add one of them: an SDOF
+    joint's micro-slip, not the damper's messenger."""
+    where = _unexplained(0.1, {"hysteresis": 60.0})[-1]
+    assert "4.7-6.1 Hz" in where and "a bolted joint's micro-slip" in where and "messenger" not in where
+    assert "--candidates FILE.toml" in where
+    assert "messenger's frequency-dependent loss" in FAMILY["damper"].outside

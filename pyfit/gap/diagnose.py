@@ -38,7 +38,7 @@ class DiagnoseConfig:
 
     effects: list | None = None  # candidate effects to test (default: all of the system's)
     calibration: list | None = None  # file stems to calibrate on (default: every level but the middle one)
-    bands_hz: list | None = None  # [[lo, hi], ...] (default: 8 log-spaced bands over the excited range)
+    bands_hz: list | None = None  # [[lo, hi], ...] (default: localise.default_bands, 8 over the excited range)
     nominal_budget: int = 60  # FMU evaluations of the nominal calibration
     refit_budget: int = 120  # FMU evaluations per refit with an effect
     upsample: int | None = None  # FMU input grid = sensor rate x upsample (None: the family's, systems.System)

@@ -276,8 +276,14 @@ def excited_range(records: list[Record]) -> tuple[float, float]:
     return min(b[0] for b in bands), max(b[1] for b in bands)
 
 
+BAND_SPAN = 32.0  # the default bands span at most this factor (five octaves) below their top
+
+
 def default_bands(records: list[Record], n: int = 8) -> list[tuple[float, float]]:
-    """n log-spaced bands over the lines the inputs excite (from 0.8x the lowest to 1.2x the highest)."""
+    """n log-spaced bands over the lines the inputs excite (from 0.8x the lowest to 1.2x the highest), at most
+    BAND_SPAN wide: a sweep from 0 Hz excites down to a fraction of a hertz but spends a fraction of a second
+    there, and bands spread over those decades would leave the response in one band and the others empty."""
     lo, hi = excited_range(records)
-    edges = np.geomspace(0.8 * lo, min(1.2 * hi, records[0].fs / 2), n + 1)
+    top = min(1.2 * hi, records[0].fs / 2)
+    edges = np.geomspace(max(0.8 * lo, top / BAND_SPAN), top, n + 1)
     return [(float(a), float(b)) for a, b in zip(edges[:-1], edges[1:])]

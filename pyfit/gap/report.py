@@ -97,9 +97,10 @@ POOR_LINEAR_NRMSE = 0.5  # a linear model at this NRMSE on a file reproduces 3/4
 
 
 def not_explained_lines(best: dict, ranking: list[dict], gap: dict, best_calibration: tuple[float, str],
-                        explained_below: float, cfg) -> list[str]:
+                        explained_below: float, cfg, outside: str) -> list[str]:
     """The evidence of a gap no candidate explains: the best candidate against the criterion, each candidate's
-    shrink, where the misfit left is largest and what to try next. When the calibrated nominal misfits even its
+    shrink, where the misfit left is largest, which effects outside the candidates are common in such systems
+    (`outside`, System.outside) and what to try next. When the calibrated nominal misfits even its
     best calibration file by more than POOR_LINEAR_NRMSE and no refit removes `cfg.min_shrink_pct` of the
     held-out misfit, that is said first: every refit starts from that nominal and takes its ranges from it (its
     stiffness, its deflection), so it can stop short of an effect that is there."""
@@ -109,9 +110,10 @@ def not_explained_lines(best: dict, ranking: list[dict], gap: dict, best_calibra
              "held-out shrink by candidate: " + ", ".join(f"{d['effect']} {d['shrink_pct']:.1f} %"
                                                           for d in ranking[:5]),
              f"the misfit left is largest in the band {gap['worst_band_hz'][0]:.1f}-"
-             f"{gap['worst_band_hz'][1]:.1f} Hz: an effect outside the candidates acts there (a delay "
-             "between the channels, the messenger's frequency-dependent loss, backlash), or the "
-             "description of the system (--nominal) is off there"]
+             f"{gap['worst_band_hz'][1]:.1f} Hz: an effect outside the candidates acts there ({outside}), or "
+             "the description of the system (--nominal) is off there; an effect you can model can be declared "
+             "as a candidate of your own (--candidates FILE.toml: FMU parameters, bounds and start rule) and "
+             "screened, refitted and ranked with these"]
     nrmse, name = best_calibration
     most = max(d["shrink_pct"] for d in ranking)
     if nrmse > POOR_LINEAR_NRMSE and most < cfg.min_shrink_pct:
@@ -205,7 +207,8 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
                           f"one) but the model with {refit_name} fits them at {refit_cal:.3f}: the response changes "
                           "strongly with amplitude"]
     if significant and nominal_fits and not chosen and best:
-        evidence = not_explained_lines(best, ranking, gap, (best_cal, best_file), explained_below, cfg)
+        evidence = not_explained_lines(best, ranking, gap, (best_cal, best_file), explained_below, cfg,
+                                       system.outside)
     if chosen:
         sys_effect = system.effects[chosen]
         ranked_screen = sorted(screening, key=lambda k: -screening[k])

@@ -135,6 +135,7 @@ class System:
     smooth_inputs: bool = False  # drive the FMU with the inputs' cubic spline (pyfit.runtime.drive), not lines
     gains_free: bool = False  # every parameter is fitted from the data (a family that starts from the data, none
     # described): a channel's unknown gain (a voltage read in the model's unit) rescales them and no verdict
+    outside: str = ""  # effects outside the candidates that are common in such systems (a report's hint)
 
 
 def combine(effects: list[Effect]) -> Effect:
@@ -511,18 +512,23 @@ class _Family:
     # SDOF family keeps lines at four times, with which its campaign calibrated the stated confidence
     upsample: int = 4
     smooth_inputs: bool = False
+    outside: str = ""  # System.outside
 
 
 FAMILY = {
     "sdof": _Family("SDOFBoucWen", {"exc_type": 0, "alpha": 0.0, "k3": 0.0, "F_c": 0.0, "c2": 0.0},
                     ("m", "c", "k"), "k", sdof_start, sdof_file_starts, sdof_bounds, sdof_stiffness, sdof_deflection,
-                    ("y",), (), SDOF_EFFECTS, 1),
+                    ("y",), (), SDOF_EFFECTS, 1, outside="a joint whose loops follow another law than the "
+                    "hysteresis candidate's, as a bolted joint's micro-slip does; backlash; a delay between the "
+                    "channels"),
     "damper": _Family("StockbridgeDamper",
                       {"exc_type": 0, "k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "F_c1": 0.0,
                        "F_c2": 0.0, "c2_1": 0.0, "c2_2": 0.0},
                       ("EI", "alpha_pd", "beta_pd"), "EI", None, damper_modal_starts, damper_bounds, damper_stiffness,
                       damper_deflection, ("x1",), ("x_base", "v_base", "a_base"), DAMPER_EFFECTS, 2,
-                      ("alpha_pd", "beta_pd"), _damper_stuck_force_of, upsample=2, smooth_inputs=True),
+                      ("alpha_pd", "beta_pd"), _damper_stuck_force_of, upsample=2, smooth_inputs=True,
+                      outside="a delay between the channels; the messenger's frequency-dependent loss; a loose "
+                      "clamp's backlash"),
 }
 
 
@@ -578,4 +584,4 @@ def make_system(name: str, defaults: dict, nominal=None) -> System:
     return System(name, fam.fmu, {**fam.switches, **fixed}, linear, fam.stiffness, start, data_starts, bounds,
                   scale, fam.effects, fam.lead_periods, fam.deflection_outputs, fam.motion_inputs, fam.deflection,
                   tuple(n for n in fam.damping if n in linear), fam.upsample, fam.smooth_inputs,
-                  fam.data_start is not None and not fixed)
+                  fam.data_start is not None and not fixed, fam.outside)
