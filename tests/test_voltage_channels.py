@@ -1,10 +1,10 @@
 """Channels recorded as voltages and channels in the wrong quantity (pyfit.io.data.check_quantities).
 
 A shaker test without a force cell records the amplifier's drive voltage, an electronic oscillator its node
-voltages: each is the model variable times a gain nobody measured. The SDOF equation divided through by the
-drive's gain G [N/V] and written in the sensor's output y' = H y [V] is the same equation in other units,
-(m/GH) y'' + (c/GH) y' + (k/GH) y' + k3/(G H^3) y'^3 = u' (theory §1.1), so the diagnosis must name the same
-effect and its fitted values must be the truth's divided by those factors. Here a random SDOF with a random cubic
+voltages: each is the model variable times a gain nobody measured. With the drive U = u/G [V] (G in N/V) and the
+sensor Y = H y [V], the SDOF equation (theory §1.1) divided by G is the same equation in other units,
+(m/GH) Y'' + (c/GH) Y' + (k/GH) Y + k3/(G H^3) Y^3 = U, so the diagnosis must name the same effect and its
+fitted values must be the truth's divided by those factors. Here a random SDOF with a random cubic
 spring is simulated by the CasADi reference, its force rewritten in V and its displacement in mV at random gains.
 A force column given in mm, or a damper's channel in V (its described geometry fixes the scale), is refused with
 one error naming the sidecar's field."""
