@@ -48,7 +48,8 @@ def test_bad_arguments_give_one_clear_error(tmp_path):
     assert res.returncode == 2 and "nowhere" in res.stderr and "Traceback" not in res.stderr
     res = run(sys.executable, "-m", "pyfit.cli", "simulate", "SDOFBoucWen", "--set", "beta=abc")
     assert res.returncode == 2 and "--set takes NAME=VALUE with a numeric VALUE" in res.stderr
-    for job, arg, value in (("diagnose", "--campaign", "0"), ("diagnose", "--workers", "-2"), ("fit", "--repeats", "x")):
+    for job, arg, value in (("diagnose", "--campaign", "0"), ("diagnose", "--workers", "-2"),
+                            ("fit", "--repeats", "x")):
         res = run(sys.executable, "-m", "pyfit.cli", job, arg, value)
         assert res.returncode == 2 and f"argument {arg}: '{value}': a whole number of at least 1" in res.stderr
     res = run(sys.executable, "-m", "pyfit.cli", "diagnose", "--model", "sdfo", "--data", str(tmp_path))

@@ -16,7 +16,7 @@ import threadpoolctl
 
 from pyfit.runtime.batch import map_tasks
 from pyfit.runtime.clock import StageClock
-from pyfit.io.data import QUANTITY, MeasurementError, check_quantities, read_dataset_with_order
+from pyfit.io.data import MeasurementError, check_quantities, read_dataset_with_order
 from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
 from pyfit.runtime.examples import ensure_fmu
@@ -122,6 +122,7 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
     if len(ms) < 2:
         raise DiagnoseError(f"{data_dir}: a diagnosis needs at least two files (one to calibrate on, one held "
                             f"out); found {len(ms)}")
+    voltages = set()  # 'column (model_variable)' of the channels recorded as voltages
     for m in ms:
         if m.model != system.fmu:
             raise DiagnoseError(f"{m.path.with_suffix('.toml')}: model = '{m.model}' but --model {system.name} "
@@ -130,12 +131,9 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
             raise DiagnoseError(f"{m.path.with_suffix('.toml')}: sample_rate_hz = {m.sample_rate_hz:g} but "
                                 f"{ms[0].path.name} has {ms[0].sample_rate_hz:g}; a dataset needs one rate")
         try:
-            check_quantities(m, units, system.gains_free)
+            voltages.update(check_quantities(m, units, system.gains_free))
         except MeasurementError as exc:
             raise DiagnoseError(str(exc)) from exc
-    voltages = sorted({f"{ch.column} ({ch.model_variable})" for m in ms for ch in [*m.inputs.values(),
-                                                                                 *m.outputs.values()]
-                       if QUANTITY[ch.unit] == "voltage"})
     unknown = [e for e in (cfg.effects or []) if e not in system.effects]
     if unknown:
         raise DiagnoseError(f"effects: '{unknown[0]}' unknown for {system.name}; allowed: "
@@ -175,7 +173,7 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
     for m in ms:
         digest.update(m.path.read_bytes())
         digest.update(m.path.with_suffix(".toml").read_bytes())
-    return Dataset(records, cal, held, digest.hexdigest()[:16], order, aside, voltages)
+    return Dataset(records, cal, held, digest.hexdigest()[:16], order, aside, sorted(voltages))
 
 
 def _simulated(runner, records, values: dict, system, cfg: DiagnoseConfig) -> dict:

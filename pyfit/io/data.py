@@ -360,16 +360,20 @@ def read_dataset(folder: str | pathlib.Path) -> list[Measurement]:
     return read_dataset_with_order(folder)[0]
 
 
-def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool) -> None:
+def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool) -> list[str]:
     """Check that each channel's unit measures its model variable's quantity (model_units: variable -> the
     model's unit, e.g. 'N' from the FMU), or, where `voltages`, is a voltage proportional to it (read in the
-    model's unit, its gain unknown: every parameter the model fits then carries that gain). Raises
-    MeasurementError naming the sidecar's field and the units allowed."""
+    model's unit, its gain unknown: every parameter the model fits then carries that gain); returns the voltage
+    channels as 'column (model_variable)'. Raises MeasurementError naming the sidecar's field and the units
+    allowed."""
     side = m.path.with_suffix(".toml")
+    volts = []
     for section, channels in (("inputs", m.inputs), ("outputs", m.outputs)):
         for col, ch in channels.items():
             unit = unit_key(model_units.get(ch.model_variable, ""))
             want, got = QUANTITY.get(unit), QUANTITY[ch.unit]
+            if got == "voltage" and voltages:
+                volts.append(f"{col} ({ch.model_variable})")
             if want is None or got == want or (voltages and got == "voltage"):
                 continue
             allowed = [u for u, q in QUANTITY.items() if q == want or (voltages and q == "voltage")]
@@ -377,6 +381,7 @@ def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool
                    "sensor's sensitivity)" if got == "voltage" else "")
             fail(side, f"{section}.{col}.unit", f"'{ch.unit}' measures {got}; model_variable "
                  f"'{ch.model_variable}' is {want} ({unit}){why}", ", ".join(allowed), MeasurementError)
+    return volts
 
 
 def read_dataset_with_order(folder: str | pathlib.Path) -> tuple[list[Measurement], str]:
