@@ -24,6 +24,7 @@ from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read
 from pyfit.gap import confidence, localise, selection, user_candidates
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, nominal_task, pinned, run_fit, screen
+from pyfit.gap.rate import AnalysisRate, analysis_rate, at_rate
 from pyfit.gap.systems import FAMILY, combine, family_fmu, make_system, strength_grid
 from pyfit.io.nominal import NominalModel, load_nominal
 
@@ -101,6 +102,7 @@ class Dataset:
     order: str  # what the level order rests on (pyfit.io.data.level_order)
     aside: dict  # records the default split set aside (localise.unsettled: name -> period scatter, lower floor)
     voltages: list  # 'column (model_variable)' of each channel recorded as a voltage (System.gains_free)
+    rate: AnalysisRate  # the rate the records are analysed at (the files' or decimated: pyfit.gap.rate)
 
 
 def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
@@ -134,6 +136,8 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
             voltages.update(check_quantities(m, units, system.gains_free))
         except MeasurementError as exc:
             raise DiagnoseError(str(exc)) from exc
+    rate = analysis_rate(ms)
+    ms = [at_rate(m, rate.factor) for m in ms]
     unknown = [e for e in (cfg.effects or []) if e not in system.effects]
     if unknown:
         raise DiagnoseError(f"effects: '{unknown[0]}' unknown for {system.name}; allowed: "
@@ -169,11 +173,11 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
     held = [r for r in records if r not in cal]
     if not held or not cal:
         raise DiagnoseError(f"calibration: the split leaves {'no held-out' if not held else 'no calibration'} file")
-    digest = hashlib.sha256()
+    digest = hashlib.sha256(str(rate.factor).encode())
     for m in ms:
         digest.update(m.path.read_bytes())
         digest.update(m.path.with_suffix(".toml").read_bytes())
-    return Dataset(records, cal, held, digest.hexdigest()[:16], order, aside, sorted(voltages))
+    return Dataset(records, cal, held, digest.hexdigest()[:16], order, aside, sorted(voltages), rate)
 
 
 def _simulated(runner, records, values: dict, system, cfg: DiagnoseConfig) -> dict:
@@ -852,6 +856,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     result["level_order"] = data.order
     result["set_aside"] = {name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in data.aside.items()}
     result["voltage_channels"] = data.voltages
+    result["analysis_rate"] = asdict(data.rate)
     top = result["ranking"][0]["shrink_pct"] if result["ranking"] else None
     calibration = confidence.load(confidence.settings_of(asdict(cfg)), model)
     result["confidence"] = confidence.stated(result["verdict"], result["chosen_effect"], top, calibration)

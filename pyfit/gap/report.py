@@ -408,6 +408,16 @@ def _voltage_lines(channels: list[str]) -> list[str]:
             "not.", ""]
 
 
+def _rate_lines(rate: dict | None) -> list[str]:
+    """The rate the records were analysed at, when the files were decimated (pyfit.gap.rate)."""
+    if not rate or rate["factor"] == 1:
+        return []
+    return [f"Analysed at {rate['file_hz'] / rate['factor']:.6g} Hz: the files' {rate['file_hz']:.6g} Hz decimated by "
+            f"{rate['factor']} after a zero-phase anti-alias filter (the inputs excite up to {rate['top_hz']:.1f} Hz; "
+            f"the rate kept is at least {rate['min_ratio']:g} times that, its fifth harmonic within the filter's flat "
+            "passband).", ""]
+
+
 def markdown(result: dict) -> str:
     """The report as markdown (tables, evidence, figures)."""
     g = result["gap"]
@@ -418,7 +428,8 @@ def markdown(result: dict) -> str:
     lines += [
         f"Calibrated on {', '.join(result['calibration_files'])}; held out: "
         f"{', '.join(result['held_out_files'])}. Levels ordered by {result['level_order']}.",
-        ""] + _set_aside_lines(result.get("set_aside", {})) + _voltage_lines(result.get("voltage_channels", []))
+        ""] + _set_aside_lines(result.get("set_aside", {})) + _voltage_lines(result.get("voltage_channels", [])) \
+        + _rate_lines(result.get("analysis_rate"))
     lines += [
         f"Held-out gap (NRMSE) of the nominal model: **{g['overall']:.4f}**; noise floor from the data: "
         f"{g['noise_floor']:.4f} ({', '.join(g.get('noise_floor_method', []))}){_scaled_floor(g)}; nominal "

@@ -1,0 +1,87 @@
+"""The sample rate a diagnosis works at. A diagnosis simulates and compares every sample, so its cost grows with the
+rate; a file sampled far faster than its excitation needs (a 5 kHz acquisition of a 5-40 Hz sweep) is decimated to
+at least RATE_FACTOR times the highest frequency the inputs excite, by a whole factor, after a zero-phase
+anti-alias filter (pyfit.analysis.signals.decimated). What is lost lies above the fifth harmonic of the highest
+excited frequency, which stays in the filter's flat passband (0.6 of the new Nyquist frequency)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+import scipy.signal
+
+from pyfit.analysis.kinematics import excited_lines
+from pyfit.analysis.signals import DECIMATION_TAPS, decimated
+from pyfit.io.data import Measurement
+
+# analysis rate over the highest excited frequency, at least: 20 puts the new Nyquist frequency at 10 times it and the
+# fifth harmonic (a strong hardening spring's or a friction's distortion reaches it) at 0.5 of it, inside the
+# anti-alias filter's flat passband (within 1e-4 up to 0.6). At 12 (the third harmonic kept) a damper sweep through
+# strong springs and a loop (damper campaign case 24, tests/test_envelope_led.py) was no longer named
+RATE_FACTOR = 20.0
+
+
+@dataclass(frozen=True)
+class AnalysisRate:
+    """The files' rate [Hz], the whole factor they are decimated by (1: not at all), the highest frequency the
+    inputs excite [Hz] and the least ratio of the analysis rate to it the factor keeps."""
+
+    file_hz: float
+    factor: int
+    top_hz: float
+    min_ratio: float
+
+    @property
+    def hz(self) -> float:
+        """The rate the diagnosis simulates and compares at [Hz]."""
+        return self.file_hz / self.factor
+
+
+def _period(m: Measurement) -> int:
+    """Samples per period of a periodic (multisine) record, 0 otherwise."""
+    exc = m.excitation or {}
+    return int(exc.get("samples_per_period", 0)) if exc.get("kind") == "multisine" else 0
+
+
+def _top(u: np.ndarray, fs: float, samples_per_period: int, fraction: float = 1e-3) -> float:
+    """The highest frequency [Hz] an input excites: of whole periods, its highest excited DFT line
+    (kinematics.excited_lines); otherwise the highest where its Welch spectrum over segments of a quarter of the
+    record (half overlapping: together the whole record, a sweep's last seconds included) is above `fraction` of
+    its peak."""
+    if samples_per_period:
+        lines = excited_lines(u, fs, samples_per_period)
+        if lines is not None:
+            return lines[1]
+    seg = len(u) // 4
+    f, p = scipy.signal.welch(u - np.mean(u), fs, window="hann", nperseg=seg, noverlap=seg // 2)
+    return float(f[np.flatnonzero(p > fraction * p[1:].max())[-1]])
+
+
+def analysis_rate(ms: list[Measurement], factor: float = RATE_FACTOR) -> AnalysisRate:
+    """The rate of a dataset's files (one rate, checked by the caller) and the largest whole decimation factor that
+    keeps at least `factor` times the highest frequency any input of any file excites (_top) and, for whole
+    periods, divides every record's samples per period."""
+    fs = ms[0].sample_rate_hz
+    inputs = [(u, _period(m)) for m in ms for u in m.by_variable("inputs").values() if np.ptp(u) > 0]
+    if not inputs:  # nothing excited to take a band from (the diagnosis says what is wrong with such files)
+        return AnalysisRate(fs, 1, fs / 2, factor)
+    top = max(_top(u, fs, spp) for u, spp in inputs)
+    q = max(1, int(fs // (factor * top)))
+    while q > 1 and any(_period(m) % q for m in ms if _period(m)):
+        q -= 1
+    return AnalysisRate(fs, q, top, factor)
+
+
+def at_rate(m: Measurement, q: int) -> Measurement:
+    """The measurement decimated by q (every channel; a multisine's samples per period with it). A record that is
+    not periodic loses its last DECIMATION_TAPS samples, where the anti-alias filter reaches past its end (its
+    start is kept: a record from rest was at rest before it, and one that is not is compared only after its
+    start-up transient, pyfit.gap.simulate.record_of)."""
+    if q == 1:
+        return m
+    spp = _period(m)
+    end = None if spp else -DECIMATION_TAPS
+    values = {c: decimated(v, q, periodic=bool(spp))[:end] for c, v in m.values.items()}
+    excitation = {**m.excitation, "samples_per_period": spp // q} if spp else m.excitation
+    t = m.t[0] + np.arange(len(next(iter(values.values())))) * q / m.sample_rate_hz
+    return replace(m, t=t, values=values, excitation=excitation)
