@@ -56,6 +56,7 @@ def test_a_multisine_keeps_whole_periods(tmp_path):
     assert rate.top_hz == pytest.approx(34 * fs / spp)
     assert fs / (4 * RATE_FACTOR * rate.top_hz) >= 1  # 4 would keep the ratio but splits a period
     assert rate.factor == 3 and rate.hz == 2000.0
+    assert analysis_rate([ms[0], dataclasses.replace(ms[1], t=ms[1].t[:-7])]).factor == 1  # not whole periods
     m = at_rate(ms[0], rate.factor)
     assert m.excitation["samples_per_period"] == 1022 and len(m.t) == 2044 and m.sample_rate_hz == pytest.approx(2000)
 

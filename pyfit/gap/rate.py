@@ -16,8 +16,8 @@ from pyfit.io.data import Measurement
 
 # analysis rate over the highest excited frequency, at least: 20 puts the new Nyquist frequency at 10 times it and the
 # fifth harmonic (a strong hardening spring's or a friction's distortion reaches it) at 0.5 of it, inside the
-# anti-alias filter's flat passband (within 1e-4 up to 0.6). At 12 (the third harmonic kept) a damper sweep through
-# strong springs and a loop (damper campaign case 24, tests/test_envelope_led.py) was no longer named
+# anti-alias filter's flat passband (within 1e-4 up to 0.6). At 12, which keeps the third, the envelope-led search
+# misses a damper sweep through strong springs and a loop (damper campaign case 24, tests/test_envelope_led.py)
 RATE_FACTOR = 20.0
 
 
@@ -60,13 +60,15 @@ def _top(u: np.ndarray, fs: float, samples_per_period: int, fraction: float = 1e
 def analysis_rate(ms: list[Measurement], factor: float = RATE_FACTOR) -> AnalysisRate:
     """The rate of a dataset's files (one rate, checked by the caller) and the largest whole decimation factor that
     keeps at least `factor` times the highest frequency any input of any file excites (_top) and, for whole
-    periods, divides every record's samples per period."""
+    periods, divides every record's samples per period (1 when a multisine record is not whole periods)."""
     fs = ms[0].sample_rate_hz
     inputs = [(u, _period(m)) for m in ms for u in m.by_variable("inputs").values() if np.ptp(u) > 0]
     if not inputs:  # nothing excited to take a band from (the diagnosis says what is wrong with such files)
         return AnalysisRate(fs, 1, fs / 2, factor)
     top = max(_top(u, fs, spp) for u, spp in inputs)
     q = max(1, int(fs // (factor * top)))
+    if any(_period(m) and len(m.t) % _period(m) for m in ms):
+        q = 1  # not whole periods: refused with the file's own numbers (simulate.record_of)
     while q > 1 and any(_period(m) % q for m in ms if _period(m)):
         q -= 1
     return AnalysisRate(fs, q, top, factor)

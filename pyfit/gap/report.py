@@ -414,8 +414,7 @@ def _rate_lines(rate: dict | None) -> list[str]:
         return []
     return [f"Analysed at {rate['file_hz'] / rate['factor']:.6g} Hz: the files' {rate['file_hz']:.6g} Hz decimated by "
             f"{rate['factor']} after a zero-phase anti-alias filter (the inputs excite up to {rate['top_hz']:.1f} Hz; "
-            f"the rate kept is at least {rate['min_ratio']:g} times that, its fifth harmonic within the filter's flat "
-            "passband).", ""]
+            f"the rate kept is at least {rate['min_ratio']:g} times that).", ""]
 
 
 def markdown(result: dict) -> str:
