@@ -8,10 +8,9 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.signal
 
 from pyfit.analysis.kinematics import excited_lines
-from pyfit.analysis.signals import DECIMATION_TAPS, decimated
+from pyfit.analysis.signals import DECIMATION_TAPS, decimated, welch_psd
 from pyfit.io.data import Measurement
 
 # analysis rate over the highest excited frequency, at least: 20 puts the new Nyquist frequency at 10 times it and the
@@ -37,12 +36,6 @@ class AnalysisRate:
         return self.file_hz / self.factor
 
 
-def _period(m: Measurement) -> int:
-    """Samples per period of a periodic (multisine) record, 0 otherwise."""
-    exc = m.excitation or {}
-    return int(exc.get("samples_per_period", 0)) if exc.get("kind") == "multisine" else 0
-
-
 def _top(u: np.ndarray, fs: float, samples_per_period: int, fraction: float = 1e-3) -> float:
     """The highest frequency [Hz] an input excites: of whole periods, its highest excited DFT line
     (kinematics.excited_lines); otherwise the highest where its Welch spectrum over segments of a quarter of the
@@ -52,8 +45,7 @@ def _top(u: np.ndarray, fs: float, samples_per_period: int, fraction: float = 1e
         lines = excited_lines(u, fs, samples_per_period)
         if lines is not None:
             return lines[1]
-    seg = len(u) // 4
-    f, p = scipy.signal.welch(u - np.mean(u), fs, window="hann", nperseg=seg, noverlap=seg // 2)
+    f, p = welch_psd(u - np.mean(u), fs, len(u) / (4 * fs))
     return float(f[np.flatnonzero(p > fraction * p[1:].max())[-1]])
 
 
@@ -62,14 +54,14 @@ def analysis_rate(ms: list[Measurement], factor: float = RATE_FACTOR) -> Analysi
     keeps at least `factor` times the highest frequency any input of any file excites (_top) and, for whole
     periods, divides every record's samples per period (1 when a multisine record is not whole periods)."""
     fs = ms[0].sample_rate_hz
-    inputs = [(u, _period(m)) for m in ms for u in m.by_variable("inputs").values() if np.ptp(u) > 0]
+    inputs = [(u, m.samples_per_period) for m in ms for u in m.by_variable("inputs").values() if np.ptp(u) > 0]
     if not inputs:  # nothing excited to take a band from (the diagnosis says what is wrong with such files)
         return AnalysisRate(fs, 1, fs / 2, factor)
     top = max(_top(u, fs, spp) for u, spp in inputs)
     q = max(1, int(fs // (factor * top)))
-    if any(_period(m) and len(m.t) % _period(m) for m in ms):
+    if any(m.samples_per_period and len(m.t) % m.samples_per_period for m in ms):
         q = 1  # not whole periods: refused with the file's own numbers (simulate.record_of)
-    while q > 1 and any(_period(m) % q for m in ms if _period(m)):
+    while q > 1 and any(m.samples_per_period % q for m in ms if m.samples_per_period):
         q -= 1
     return AnalysisRate(fs, q, top, factor)
 
@@ -81,7 +73,7 @@ def at_rate(m: Measurement, q: int) -> Measurement:
     start-up transient, pyfit.gap.simulate.record_of)."""
     if q == 1:
         return m
-    spp = _period(m)
+    spp = m.samples_per_period
     end = None if spp else -DECIMATION_TAPS
     values = {c: decimated(v, q, periodic=bool(spp))[:end] for c, v in m.values.items()}
     excitation = {**m.excitation, "samples_per_period": spp // q} if spp else m.excitation

@@ -89,8 +89,7 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0, smoo
     A non-periodic record that does not start at rest (a segment cut from a long record) is simulated from
     rest and its first transient_s seconds (at most a quarter of the record) are not compared (the start-up
     transient of the simulation)."""
-    exc = m.excitation or {}
-    spp = int(exc.get("samples_per_period", 0)) if exc.get("kind") == "multisine" else 0
+    spp = m.samples_per_period
     n = len(m.t)
     if spp and n % spp:
         raise ValueError(f"{m.path}: {n} samples is not a whole number of periods of {spp} "

@@ -89,6 +89,12 @@ class Measurement:
     def sample_rate_hz(self) -> float:
         return 1.0 / (self.t[1] - self.t[0])
 
+    @property
+    def samples_per_period(self) -> int:
+        """Samples per period of a periodic record (excitation kind multisine), 0 otherwise."""
+        exc = self.excitation or {}
+        return int(exc.get("samples_per_period", 0)) if exc.get("kind") == "multisine" else 0
+
     def by_variable(self, kind: str = "outputs") -> dict[str, np.ndarray]:
         """Signals keyed by model variable name."""
         return {ch.model_variable: self.values[c] for c, ch in getattr(self, kind).items()}
