@@ -5,7 +5,10 @@ to at least RATE_FACTOR times the highest excited frequency after a zero-phase a
 The filter is checked against analytic signals: whole periods of a multisine come back exactly on the coarser grid,
 a sine in the flat passband (below 0.6 of the new Nyquist frequency) within 1e-4 of its amplitude, a sine above the
 new Nyquist frequency attenuated by at least 100 dB. A diagnosis of an SDOF with a random cubic spring recorded by
-the CasADi reference at a random rate 42-55 times its sweep's top frequency is analysed at half that rate, names the spring and recovers its strength within 2 % and the linear stiffness within 1 %."""
+the CasADi reference at a random rate 42-55 times its sweep's top frequency is analysed at half that rate, names the spring and recovers its strength within 2 % and the linear stiffness within 1 %.
+
+The FMU's drive grid follows the analysis rate (drive_upsample): a file faster than REFERENCE_HZ is driven on as many
+grid points a second as a file at that rate, and meets a closed-form response at least as well as one."""
 import dataclasses
 
 import numpy as np
@@ -15,8 +18,11 @@ from gap_cases import CI
 from pyfit.analysis.signals import DECIMATION_TAPS, decimated
 from pyfit.gap import datasets
 from pyfit.gap import diagnose as dg
-from pyfit.gap.rate import RATE_FACTOR, analysis_rate, at_rate
+from pyfit.gap import simulate as sim
+from pyfit.gap.rate import RATE_FACTOR, REFERENCE_HZ, AnalysisRate, analysis_rate, at_rate, drive_upsample
 from pyfit.io.data import read_dataset, write_measurement
+from pyfit.runtime.drive import drive
+from test_spline_drive import LINEAR, forced_from_rest
 
 
 def test_whole_periods_decimate_exactly():
@@ -99,6 +105,7 @@ def test_a_fast_record_is_diagnosed_at_a_lower_rate_with_the_same_result(fast_sd
     rate = rep["analysis_rate"]
     assert rate["factor"] == 2 and rate["file_hz"] == pytest.approx(fs)
     assert fs / rate["factor"] >= RATE_FACTOR * rate["top_hz"] and 58.0 <= rate["top_hz"] <= 63.0  # the sweep's 60 Hz
+    assert rate["drive_upsample"] == 2  # 2.6-3.4 kHz grid: at least the 2 kHz the SDOF family's 500 Hz files have
     assert rep["chosen_effect"] == "cubic_stiffness", rep["verdict"]
     fitted = rep["ranking"][0]["params"]
     measured("SDOF recorded at 42-55 x its top frequency, decimated: |k3'/k3 - 1|",
@@ -106,3 +113,44 @@ def test_a_fast_record_is_diagnosed_at_a_lower_rate_with_the_same_result(fast_sd
     measured("SDOF recorded at 42-55 x its top frequency, decimated: |k'/k - 1|", abs(fitted["k"] / truth["k"] - 1.0),
              0.01)
     assert f"decimated by {rate['factor']}" in (root / "out" / "report.md").read_text()
+
+
+def test_the_drive_grid_keeps_the_familys_points_per_second_and_per_excited_cycle():
+    """drive_upsample: a file at REFERENCE_HZ keeps its family's grid whatever its excitation (the grid the
+    campaigns calibrated on); a faster one keeps as many grid points a second, or per sample of twice its highest
+    excited frequency when that is the more; a slower one keeps the family's multiple."""
+    for upsample in (2, 4):
+        for top in np.linspace(1.0, REFERENCE_HZ / 2, 50):
+            assert drive_upsample(upsample, AnalysisRate(REFERENCE_HZ, 1, float(top), RATE_FACTOR)) == upsample
+        assert drive_upsample(upsample, AnalysisRate(200.0, 1, 40.0, RATE_FACTOR)) == upsample
+    assert drive_upsample(2, AnalysisRate(1000.0, 1, 40.0, RATE_FACTOR)) == 1  # a damper file at 1 kHz
+    assert drive_upsample(4, AnalysisRate(1000.0, 1, 80.0, RATE_FACTOR)) == 2  # an SDOF one: 2 kHz as at 500 Hz
+    assert drive_upsample(2, AnalysisRate(2500.0, 3, 40.0, RATE_FACTOR)) == 2  # decimated to 833 Hz: 1.67 kHz
+    # broadband noise to 0.65 of the Nyquist frequency at 10 kHz: 4 points per sample of 6.5 kHz
+    assert drive_upsample(4, AnalysisRate(1e4, 1, 3250.0, RATE_FACTOR)) == 3
+
+
+@pytest.mark.parametrize("smooth, upsample, tolerance", [(True, 2, sim.SPLINE_TOLERANCE), (False, 4, sim.TOLERANCE)],
+                         ids=["spline (damper)", "lines (SDOF)"])
+def test_a_faster_file_on_its_coarser_grid_meets_the_closed_form_as_well(runner, measured, smooth, upsample,
+                                                                          tolerance):
+    """A linear oscillator (test_spline_drive) forced at 35 Hz from rest, its force sampled at REFERENCE_HZ and at
+    twice that: the faster file driven on the grid drive_upsample gives it (as many points a second, half as many
+    per sample) meets the closed form at least as well as the slower file on its family's grid, for either drive."""
+    m, c, k, f0, w = 2.0, 2 * 0.02 * np.sqrt(1.2e5 * 2.0), 1.2e5, 10.0, 2 * np.pi * 35.0
+    fmu, params = runner("SDOFBoucWen"), {**LINEAR, "m": m, "c": c, "k": k}
+
+    def error(fs, grid):
+        t = np.arange(int(2 * fs) + 1) / fs
+        exact = forced_from_rest(m, c, k, f0, w, t)
+        y = drive(fmu, {"u": f0 * np.sin(w * t)}, fs, ["y"], params, grid, tolerance=tolerance,
+                  smooth_inputs=smooth).values["y"]
+        return np.sqrt(np.mean((y - exact) ** 2) / np.mean(exact ** 2))
+
+    grid = drive_upsample(upsample, AnalysisRate(2 * REFERENCE_HZ, 1, 35.0, RATE_FACTOR))
+    assert grid == upsample // 2
+    slow, fast = error(REFERENCE_HZ, upsample), error(2 * REFERENCE_HZ, grid)
+    # (measured: the spline 5.9e-5 at 500 Hz, 8.1e-6 at 1 kHz; the lines 1.06e-3 and 1.01e-3, the same grid's lines)
+    measured(f"linear oscillator forced at 35 Hz, {'spline' if smooth else 'lines'}: NRMSE against the closed form "
+             f"of a {2 * REFERENCE_HZ:g} Hz file on {grid} grid point(s) per sample over a {REFERENCE_HZ:g} Hz "
+             f"file's on {upsample}", fast / slow, 1.0)

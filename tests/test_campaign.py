@@ -67,11 +67,10 @@ def test_a_campaign_read_back_states_every_report_with_the_calibration_it_reads(
     as a report diagnosed in this run states it."""
     from dataclasses import asdict
 
-    from pyfit.gap.diagnose import DiagnoseConfig, load_config, with_family_drive
+    from pyfit.gap.diagnose import DiagnoseConfig, load_config
 
     path = None if config is None else str(ROOT / "configs" / config)
-    package = confidence.load(confidence.settings_of(asdict(with_family_drive(
-        load_config(path) if path else DiagnoseConfig(), model))), model)
+    package = confidence.load(confidence.settings_of(asdict(load_config(path) if path else DiagnoseConfig())), model)
     assert package is not None and package["model"] == model
     for c in campaign.draw(3, seed=0, model=model):
         named = c.withheld

@@ -92,9 +92,9 @@ def test_a_calibration_is_read_for_the_settings_it_was_made_with_only(tmp_path):
 def test_the_package_carries_a_calibration_of_the_default_settings_from_a_campaign():
     from dataclasses import asdict
 
-    from pyfit.gap.diagnose import DiagnoseConfig, with_family_drive
+    from pyfit.gap.diagnose import DiagnoseConfig
 
-    cal = confidence.load(confidence.settings_of(asdict(with_family_drive(DiagnoseConfig(), "sdof"))))
+    cal = confidence.load(confidence.settings_of(asdict(DiagnoseConfig())))
     assert cal is not None and cal["source"].startswith("stockbridge diagnose --campaign ")
     assert sum(r["named"] for r in cal["by_shrink"]) + cal["no_gap"]["verdicts"] <= cal["cases"]
     assert np.all([0 <= r["right"] <= r["named"] for r in cal["by_shrink"]])

@@ -33,8 +33,8 @@ def test_an_envelope_fit_minimises_the_envelopes_misfit(tmp_path, sdof_system, m
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "cubic_stiffness", seed=int(rng.integers(1e6)),
                                   truth={"k3": float(rng.uniform(5e7, 2e8))},
                                   style=datasets.LabStyle("sweep", ("y",), record_s=6.0))
-    cfg = dg.with_family_drive(dg.DiagnoseConfig(), "sdof")
-    cal = dg._load(data, system, cfg, runner).cal
+    loaded = dg._load(data, system, dg.DiagnoseConfig(), runner)
+    cal, cfg = loaded.cal, dg.with_drive(dg.DiagnoseConfig(), system, loaded.rate)
     nominal = run_fit(nominal_task(system, runner.path, cal, 30, cfg.upsample))
     moved = [sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods,
                           outputs=system.deflection_outputs) for r in cal]

@@ -104,7 +104,7 @@ def test_a_linear_candidate_tells_no_gap_below_the_noise_threshold(tmp_path, fmu
     gap', as the nonlinear candidates' refits against their own linear parts say."""
     null = campaign.draw(100, seed=1, model="damper")[13]
     assert null.withheld == "none"
-    cfg = dg.with_family_drive(dg.DiagnoseConfig(), "damper")
+    cfg = dg.DiagnoseConfig()
     outcome = campaign.run_case(campaign.CaseJob(null, str(tmp_path), str(fmu_dir), campaign.RECORD_S, cfg))
     assert outcome["named"] == "none" and outcome["verdict"] == "no significant gap", outcome["verdict"]
     rep = json.loads((tmp_path / "case0013" / "diagnosis" / "report.json").read_text())

@@ -41,8 +41,8 @@ def test_a_spring_and_damper_setting_a_sweeps_jump_are_found_from_the_grid(tmp_p
     style = datasets.LabStyle(case.excitation, tuple(case.outputs), case.motion, record_s=campaign.RECORD_S)
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, case.withheld, seed=case.seed,
                                   periods=campaign.PERIODS, style=style, truth=case.truth)
-    cfg = dg.with_family_drive(dg.DiagnoseConfig(), "sdof")
-    loaded = dg._load(data, system, cfg, runner)
+    loaded = dg._load(data, system, dg.DiagnoseConfig(), runner)
+    cfg = dg.with_drive(dg.DiagnoseConfig(), system, loaded.rate)
     records, cal, held = loaded.records, loaded.cal, loaded.held
     nominal = run_fit(nominal_task(system, fmu, cal, cfg.nominal_budget, cfg.upsample, threads=2))
     moved = [sim.simulate(runner, r, nominal.params, cfg.upsample, system.lead_periods,

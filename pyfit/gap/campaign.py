@@ -31,7 +31,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from pyfit.gap import confidence, datasets, selection, sizing
-from pyfit.gap.diagnose import DiagnoseConfig, diagnose, load_config, misfit_at, with_family_drive
+from pyfit.gap.diagnose import DiagnoseConfig, diagnose, load_config, misfit_at
 from pyfit.gap.systems import FAMILY
 from pyfit.io.nominal import NominalModel
 from pyfit.runtime.batch import map_tasks
@@ -261,7 +261,7 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     TOML file of diagnosis settings (pyfit.gap.diagnose.load_config; default: the defaults)."""
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    cfg = with_family_drive(load_config(config) if config else DiagnoseConfig(), model)
+    cfg = load_config(config) if config else DiagnoseConfig()
     settings = confidence.settings_of(asdict(cfg))
     stated_from = confidence.load(settings, model)
     jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg) for c in draw(n, seed, model)]

@@ -24,8 +24,8 @@ from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read
 from pyfit.gap import confidence, localise, selection, user_candidates
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, nominal_task, pinned, run_fit, screen
-from pyfit.gap.rate import AnalysisRate, analysis_rate, at_rate
-from pyfit.gap.systems import FAMILY, combine, family_fmu, make_system, strength_grid
+from pyfit.gap.rate import AnalysisRate, analysis_rate, at_rate, drive_upsample
+from pyfit.gap.systems import combine, family_fmu, make_system, strength_grid
 from pyfit.io.nominal import NominalModel, load_nominal
 
 
@@ -38,11 +38,12 @@ class DiagnoseConfig:
     """Settings of a diagnosis (all optional)."""
 
     effects: list | None = None  # candidate effects to test (default: all of the system's)
-    calibration: list | None = None  # file stems to calibrate on (default: every level but the middle one)
+    calibration: list | None = None  # file stems to calibrate on (default: the lowest and the highest level's)
     bands_hz: list | None = None  # [[lo, hi], ...] (default: localise.default_bands, 8 over the excited range)
     nominal_budget: int = 60  # FMU evaluations of the nominal calibration
     refit_budget: int = 120  # FMU evaluations per refit with an effect
-    upsample: int | None = None  # FMU input grid = sensor rate x upsample (None: the family's, systems.System)
+    upsample: int | None = None  # FMU input grid = analysis rate x upsample (None: the family's System.upsample, for
+    # a file faster than pyfit.gap.rate.REFERENCE_HZ the fewer its rate needs: rate.drive_upsample)
     transient_s: float = 4.0  # a record that does not start at rest: seconds simulated from rest, not compared
     min_gap: float = 0.005  # NRMSE a gap must exceed beyond the noise floor to count
     noise_factor: float = 1.2  # ... and the noise floor times this
@@ -166,10 +167,11 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
         if bad:
             raise DiagnoseError(f"calibration: no file '{bad[0]}' in {data_dir}; files: {', '.join(names)}")
         cal = [r for r in records if r.name in cfg.calibration]
-    else:
+    else:  # the lowest and the highest level calibrate and the levels between are held out (of three: the middle
+        # one); of two, the first file calibrates. More levels hold more out, not more into every fit's simulations
         levels = sorted({r.level_value for r in records})
-        middle = levels[len(levels) // 2] if len(levels) >= 3 else None
-        cal = [r for r in records if r.level_value != middle] if middle is not None else records[:1]
+        ends = (levels[0], levels[-1])
+        cal = [r for r in records if r.level_value in ends] if len(levels) >= 3 else records[:1]
     held = [r for r in records if r not in cal]
     if not held or not cal:
         raise DiagnoseError(f"calibration: the split leaves {'no held-out' if not held else 'no calibration'} file")
@@ -241,9 +243,11 @@ def _run_fits(jobs, alone: int, workers, progress: bool, desc: str) -> list[Fit]
     return map_tasks(_fit_and_store, jobs, workers=workers, progress=progress, desc=desc)
 
 
-def with_family_drive(cfg: DiagnoseConfig, model: str) -> DiagnoseConfig:
-    """cfg with the drive grid of the family `model` (systems.System.upsample) when it sets none."""
-    return cfg if cfg.upsample is not None else dataclasses.replace(cfg, upsample=FAMILY[model].upsample)
+def with_drive(cfg: DiagnoseConfig, system, rate: AnalysisRate) -> DiagnoseConfig:
+    """cfg with the FMU's drive grid set: its own upsample when it sets one, else the family's for the rate the
+    records are analysed at (rate.drive_upsample)."""
+    return cfg if cfg.upsample is not None else dataclasses.replace(cfg, upsample=drive_upsample(system.upsample,
+                                                                                               rate))
 
 
 def _stem(name: str) -> str:
@@ -756,8 +760,8 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     system = make_system(model, fmu_defaults(runner), described)
     if users:
         system = _with_user_candidates(system, users, set(runner.parameter_names()))
-    cfg = with_family_drive(cfg, model)
     data = _load(data_dir, system, cfg, runner)
+    requested, cfg = cfg, with_drive(cfg, system, data.rate)
     records, cal, held, data_key = data.records, data.cal, data.held, data.key
     lo, hi = localise.excited_range(records)
     modes = linear_modes(fmu, {**system.nominal_fixed, **system.start(cal)})
@@ -856,9 +860,9 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     result["level_order"] = data.order
     result["set_aside"] = {name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in data.aside.items()}
     result["voltage_channels"] = data.voltages
-    result["analysis_rate"] = asdict(data.rate)
+    result["analysis_rate"] = {**asdict(data.rate), "drive_upsample": cfg.upsample}
     top = result["ranking"][0]["shrink_pct"] if result["ranking"] else None
-    calibration = confidence.load(confidence.settings_of(asdict(cfg)), model)
+    calibration = confidence.load(confidence.settings_of(asdict(requested)), model)  # of the settings asked for
     result["confidence"] = confidence.stated(result["verdict"], result["chosen_effect"], top, calibration)
     result["separation"] = report.separation(runner, result, records, fits, bands, cfg.upsample, system.lead_periods)
     runner.close()
@@ -887,8 +891,8 @@ def misfit_at(model: str, data_dir, params: dict, cfg: DiagnoseConfig | None = N
     try:
         system = make_system(model, fmu_defaults(runner),
                              load_nominal(nominal) if isinstance(nominal, (str, pathlib.Path)) else nominal)
-        cfg = with_family_drive(cfg, model)
         data = _load(data_dir, system, cfg, runner)
+        cfg = with_drive(cfg, system, data.rate)
         cal, held = data.cal, data.held
         values = {**system.nominal_fixed, **params}
         return SplitMisfit(*(selection.heldout_nrmse(_simulated(runner, files, values, system, cfg), files)

@@ -2,9 +2,14 @@
 rate; a file sampled far faster than its excitation needs (a 5 kHz acquisition of a 5-40 Hz sweep) is decimated to
 at least RATE_FACTOR times the highest frequency the inputs excite, by a whole factor, after a zero-phase
 anti-alias filter (pyfit.analysis.signals.decimated). What is lost lies above the fifth harmonic of the highest
-excited frequency, which stays in the filter's flat passband (0.6 of the new Nyquist frequency)."""
+excited frequency, which stays in the filter's flat passband (0.6 of the new Nyquist frequency).
+
+The FMU's drive grid follows the rate: a family drives it at `System.upsample` times the sensor rate, set at
+REFERENCE_HZ; a faster file is driven on the least whole multiple of its rate that keeps as many grid points per
+second as that, or per sample of the slowest rate its excitation allows (drive_upsample)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -18,6 +23,9 @@ from pyfit.io.data import Measurement
 # anti-alias filter's flat passband (within 1e-4 up to 0.6). At 12, which keeps the third, the envelope-led search
 # misses a damper sweep through strong springs and a loop (damper campaign case 24, tests/test_envelope_led.py)
 RATE_FACTOR = 20.0
+# the sensor rate the families' drive grids (System.upsample) were set at [Hz]: the rate of every case their
+# campaigns calibrated the stated confidence on, each file of which keeps its family's grid
+REFERENCE_HZ = 500.0
 
 
 @dataclass(frozen=True)
@@ -79,3 +87,13 @@ def at_rate(m: Measurement, q: int) -> Measurement:
     excitation = {**m.excitation, "samples_per_period": spp // q} if spp else m.excitation
     t = m.t[0] + np.arange(len(next(iter(values.values())))) * q / m.sample_rate_hz
     return replace(m, t=t, values=values, excitation=excitation)
+
+
+def drive_upsample(upsample: int, rate: AnalysisRate) -> int:
+    """The FMU's drive grid as a multiple of the analysis rate, for a family that drives files at REFERENCE_HZ
+    with `upsample`: the least whole number whose grid has at least `upsample` points per sample of REFERENCE_HZ
+    or, for an excitation above that rate's Nyquist frequency, of twice the highest excited frequency; never more
+    than `upsample` (a file at REFERENCE_HZ or slower keeps it). A 1 kHz damper file of a 5-40 Hz sweep is driven
+    at its own rate, the 1 kHz grid a 500 Hz file's is, at the cost of one."""
+    points = upsample * max(REFERENCE_HZ, 2.0 * rate.top_hz)
+    return max(1, min(upsample, math.ceil(points / rate.hz - 1e-9)))

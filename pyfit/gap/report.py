@@ -11,6 +11,7 @@ import numpy as np
 from pyfit.report import plots
 from pyfit.gap import confidence, localise, selection
 from pyfit.gap import simulate as sim
+from pyfit.gap.rate import REFERENCE_HZ
 
 
 def _rms_over(values) -> float:
@@ -409,12 +410,17 @@ def _voltage_lines(channels: list[str]) -> list[str]:
 
 
 def _rate_lines(rate: dict | None) -> list[str]:
-    """The rate the records were analysed at, when the files were decimated (pyfit.gap.rate)."""
-    if not rate or rate["factor"] == 1:
+    """The rate the records were analysed at and the FMU's drive grid, for files faster than the rate the families'
+    drive grids were set at (pyfit.gap.rate)."""
+    if not rate or rate["file_hz"] <= REFERENCE_HZ:
         return []
-    return [f"Analysed at {rate['file_hz'] / rate['factor']:.6g} Hz: the files' {rate['file_hz']:.6g} Hz decimated by "
-            f"{rate['factor']} after a zero-phase anti-alias filter (the inputs excite up to {rate['top_hz']:.1f} Hz; "
-            f"the rate kept is at least {rate['min_ratio']:g} times that).", ""]
+    hz = rate["file_hz"] / rate["factor"]
+    drive = f"the FMU driven on a {hz * rate['drive_upsample']:.6g} Hz grid ({rate['drive_upsample']} per sample)"
+    if rate["factor"] == 1:
+        return [f"Analysed at the files' {hz:.6g} Hz, {drive}; the inputs excite up to {rate['top_hz']:.1f} Hz.", ""]
+    return [f"Analysed at {hz:.6g} Hz: the files' {rate['file_hz']:.6g} Hz decimated by {rate['factor']} after a "
+            f"zero-phase anti-alias filter (the inputs excite up to {rate['top_hz']:.1f} Hz; the rate kept is at least "
+            f"{rate['min_ratio']:g} times that), {drive}.", ""]
 
 
 def markdown(result: dict) -> str:

@@ -131,7 +131,8 @@ class System:
     motion_inputs: tuple = ()  # displacement, velocity, acceleration inputs that must be consistent (or ())
     deflection: callable = None  # (simulated outputs, record) -> the element's deflection [m]
     damping: tuple = ()  # the damping parameters among `linear` the nominal's damping scan scales together
-    upsample: int = 4  # the FMU's drive grid = the sensor rate x this (DiagnoseConfig.upsample overrides it)
+    upsample: int = 4  # the FMU's drive grid = the sensor rate x this, for files at pyfit.gap.rate.REFERENCE_HZ (a faster
+    # file keeps the grid's points a second: rate.drive_upsample; DiagnoseConfig.upsample overrides it)
     smooth_inputs: bool = False  # drive the FMU with the inputs' cubic spline (pyfit.runtime.drive), not lines
     gains_free: bool = False  # every parameter is fitted from the data (a family that starts from the data, none
     # described): a channel's unknown gain (a voltage read in the model's unit) rescales them and no verdict
@@ -506,8 +507,9 @@ class _Family:
     lead_periods: int
     damping: tuple = ()  # linear parameters scaled together by the nominal's damping scan (attribute.DAMPING_SCAN)
     stuck_force: callable | None = None  # (records, params) -> Scale.stuck_force [N] (None: 0)
-    # how the measured inputs drive the FMU: the drive grid's rate over the sensor rate, and whether the FMU
-    # follows their cubic spline (pyfit.runtime.drive) or the lines between the samples: the damper's spline at
+    # how the measured inputs drive the FMU: the drive grid's rate over the sensor rate (of a file at
+    # pyfit.gap.rate.REFERENCE_HZ), and whether the FMU follows their cubic spline (pyfit.runtime.drive) or the
+    # lines between the samples: the damper's spline at
     # twice the sensor rate errs far less than lines at four times, at lower cost (bench/input_order.py); the
     # SDOF family keeps lines at four times, with which its campaign calibrated the stated confidence
     upsample: int = 4
