@@ -1,11 +1,12 @@
 """Withheld-effect datasets (pyfit.gap.datasets) with a stepped sine and band-limited noise: what the files
-hold against the signal they were made from, and the excitations a family refuses."""
+hold against the signal they were made from (a damper's clamp stepped sine: continuous motion at a constant
+velocity amplitude), and the excitations a family refuses."""
 import json
 
 import numpy as np
 import pytest
 
-from pyfit.analysis.excitation import SteppedSine, band_noise
+from pyfit.analysis.excitation import SteppedSine, band_noise, motion_with_derivatives
 from pyfit.gap import datasets
 from pyfit.io.data import read_measurement
 
@@ -40,9 +41,32 @@ def test_a_noise_file_holds_band_limited_noise_at_its_level(written):
         assert np.sqrt(np.mean(u[m.t > 1.0] ** 2)) == pytest.approx(m.excitation["rms"], rel=0.15)
 
 
-def test_a_clamp_driven_damper_refuses_a_stepped_sine(tmp_path):
-    with pytest.raises(ValueError, match="stepped_sine.*allowed: multisine, sweep, noise"):
-        datasets.write_dataset(tmp_path, datasets.DAMPER, "none", style=datasets.LabStyle("stepped_sine"))
+def test_a_clamp_stepped_sine_holds_each_velocity_amplitude_and_moves_the_clamp_continuously(tmp_path):
+    """The damper's clamp under a stepped sine (8 s, 16 steps of 0.5 s, each frequency reached over a 0.2 s glide):
+    the recorded displacement, velocity and acceleration are the controller's motion and its exact derivatives; in
+    the last 0.2 s of each step the velocity amplitude is the level; and between any two samples the displacement
+    and the velocity change by the trapezoid of their derivatives within the trapezoid rule's error for the highest
+    frequency, (omega dt)^2 / 12 of a sample's change (a jump at a step would exceed it)."""
+    data = datasets.write_dataset(tmp_path, datasets.DAMPER, "none", style=datasets.LabStyle("stepped_sine",
+                                                                                             record_s=8.0))
+    m = read_measurement(sorted(data.glob("level3_*.csv"))[0])
+    steps, dwell, level = m.excitation["frequencies"], m.excitation["dwell_s"], m.excitation["amplitude"]
+    assert m.excitation["glide_s"] == datasets.GLIDE_S and len(steps) == datasets.STEPS and dwell == 0.5
+    signal = SteppedSine(tuple(steps), dwell, level, glide_s=datasets.GLIDE_S, velocity=True)
+    motion = m.by_variable("inputs")
+    exact = motion_with_derivatives(signal, m.t, ("x_base", "v_base", "a_base"))
+    for name, values in exact.items():
+        assert np.max(np.abs(motion[name] - values)) < 1e-8 * np.max(np.abs(values)), name
+    for j in range(1, len(steps)):  # after the input's ramp and each glide
+        late = (m.t > (j + 1) * dwell - 0.2) & (m.t < (j + 1) * dwell)
+        # the largest sample of a sine lies within 1 - cos(pi f / fs) of its amplitude
+        assert np.max(np.abs(motion["v_base"][late])) == pytest.approx(
+            level, rel=1 - np.cos(np.pi * steps[j] / m.sample_rate_hz) + 1e-6)
+    dt = 1 / m.sample_rate_hz
+    bound = (2 * np.pi * steps[-1] * dt) ** 2 / 12  # measured 0.99 of it: the glides add 1.1 at most
+    for low, high in (("x_base", "v_base"), ("v_base", "a_base")):
+        rest = np.diff(motion[low]) - dt * (motion[high][1:] + motion[high][:-1]) / 2
+        assert np.max(np.abs(rest)) <= 1.1 * bound * dt * np.max(np.abs(motion[high])), low
 
 
 def _size(tmp_path, effect: str, truth: dict) -> dict:

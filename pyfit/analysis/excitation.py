@@ -93,6 +93,7 @@ def _ops(t):
 
     class _Casadi:
         minimum = staticmethod(ca.fmin)
+        maximum = staticmethod(ca.fmax)
         sin = staticmethod(ca.sin)
 
     return _Casadi
@@ -207,21 +208,50 @@ def band_noise(f_min: float, f_max: float, rms: float, seed: int = 0, lines: int
 class SteppedSine:
     """A stepped sine as a sine-test controller plays it: `amplitude` (the signal's unit) at each frequency
     of `frequencies` [Hz] for `dwell_s` seconds, the phase continuous across a step, ramped in from rest over
-    t_ramp [s]; after the last step the last frequency holds. Works on numpy arrays and CasADi expressions."""
+    t_ramp [s]; after the last step the last frequency holds. Works on numpy arrays and CasADi expressions.
+
+    glide_s > 0: the frequency glides to the next step's over the first glide_s seconds of it (the C2 ramp of
+    Excitation.envelope) instead of jumping, as a controller moving a shaker's motion does: with
+    velocity = True, `amplitude` is the velocity amplitude [signal unit/s] and the signal (a displacement) has
+    amplitude / (2 pi f(t)), so that the displacement, its velocity and its acceleration are all continuous (a
+    damper's clamp under a constant-velocity stepped sine)."""
 
     frequencies: tuple
     dwell_s: float
     amplitude: float = 1.0
     t_ramp: float = 0.5
+    glide_s: float = 0.0
+    velocity: bool = False
     kind = -1  # not a built-in FMU excitation
 
+    def __post_init__(self):
+        if self.velocity and self.glide_s <= 0:
+            raise ValueError("SteppedSine: velocity = True needs glide_s > 0 (a displacement of constant velocity "
+                             "amplitude would jump at a step)")
+
     def frequency(self, t):
-        """Instantaneous frequency [Hz] (numpy)."""
+        """Instantaneous frequency [Hz] (numpy arrays or CasADi expressions; numpy only without a glide)."""
+        if self.glide_s > 0:
+            xp = _ops(t)
+            f = np.asarray(self.frequencies, float)
+            return f[0] + sum((f[j] - f[j - 1]) * _smooth_step(xp.maximum(xp.minimum(
+                (t - j * self.dwell_s) / self.glide_s, 1.0), 0.0)) for j in range(1, len(f)))
         step = np.clip(np.floor(np.asarray(t, float) / self.dwell_s).astype(int), 0, len(self.frequencies) - 1)
         return np.asarray(self.frequencies, float)[step]
 
     def phase(self, t):
-        """Phase [rad]: 2 pi sum_j f_j (time spent in step j up to t)."""
+        """Phase [rad]: 2 pi sum_j f_j (time spent in step j up to t); with a glide, 2 pi times the integral of
+        frequency(t)."""
+        if self.glide_s > 0:
+            xp = _ops(t)
+            f, g = np.asarray(self.frequencies, float), self.glide_s
+            turns = f[0] * t
+            for j in range(1, len(f)):
+                x = (t - j * self.dwell_s) / g
+                c = xp.maximum(xp.minimum(x, 1.0), 0.0)
+                # the integral of the C2 ramp 10c^3 - 15c^4 + 6c^5 up to c, then 1 a second (in units of g)
+                turns = turns + (f[j] - f[j - 1]) * g * (c**4 * (2.5 - 3 * c + c**2) + xp.maximum(x - 1.0, 0.0))
+            return 2 * np.pi * turns
         if _is_symbolic(t):
             import casadi as ca
 
@@ -234,7 +264,13 @@ class SteppedSine:
 
     def __call__(self, t):
         xp = _ops(t)
-        return self.amplitude * Excitation(1, t_ramp=self.t_ramp).envelope(t) * xp.sin(self.phase(t))
+        amplitude = self.amplitude / (2 * np.pi * self.frequency(t)) if self.velocity else self.amplitude
+        return amplitude * Excitation(1, t_ramp=self.t_ramp).envelope(t) * xp.sin(self.phase(t))
+
+
+def _smooth_step(c):
+    """The C2 ramp 10c^3 - 15c^4 + 6c^5 from 0 to 1 over c in [0, 1] (Excitation.envelope's)."""
+    return c**3 * (10 - 15 * c + 6 * c**2)
 
 
 def motion_with_derivatives(exc: Excitation, t: np.ndarray, names: tuple[str, ...]) -> dict[str, np.ndarray]:

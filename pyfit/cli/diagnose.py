@@ -49,7 +49,8 @@ def add_arguments(ap) -> None:
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2], help="noise seeds of the null cases")
     ap.add_argument("--excitation", choices=["multisine", "sweep", "stepped_sine", "noise", "impedance"],
                     default="multisine", help="with --make-datasets: steady multisine periods, a 35 s sweep, "
-                    "stepped sine (sdof) or band-limited noise from rest, or (--model damper) an impedance test")
+                    "stepped sine (a damper's clamp gliding between its steps) or band-limited noise from rest, or "
+                    "(--model damper) an impedance test")
     ap.add_argument("--record", nargs="+", metavar="OUTPUT", help="with --make-datasets: the outputs recorded "
                     "(default: displacements; e.g. a, or acc_x1 acc_x2)")
     ap.add_argument("--campaign", type=count, metavar="N", help="validation campaign: draw N random cases of --model "

@@ -68,8 +68,11 @@ DAMPER = Family(
 FAMILIES = {"sdof": SDOF, "damper": DAMPER}
 PERIODS = 3
 EXCITATIONS = ("multisine", "sweep", "stepped_sine", "noise")  # of write_dataset (LabStyle.excitation)
-CLAMP_EXCITATIONS = ("multisine", "sweep", "noise")  # of a clamp-driven damper: its displacement cannot step
+# a campaign's damper cases draw their excitation from these (pyfit.gap.campaign); write_dataset also writes a clamp's
+# stepped sine, whose frequency glides to each step's over GLIDE_S at a constant velocity amplitude
+CLAMP_EXCITATIONS = ("multisine", "sweep", "noise")
 STEPS = 16  # frequencies of a stepped sine
+GLIDE_S = 0.2  # [s] a clamp's stepped sine moves to the next frequency over this (its motion stays continuous)
 # CVODES tolerances of the truth: against 1e-10 / 1e-14 the SDOF records change by at most 1.5e-6 of the
 # output's standard deviation, far below the sensor noise (1e-3 of it and more), in a third less time
 TRUTH_RTOL, TRUTH_ATOL = 1e-8, 1e-12
@@ -90,8 +93,8 @@ class LabStyle:
     """How a test bench would have recorded a case: the excitation ('multisine': steady-state periods;
     'sweep': a linear sweep over the family's band from rest, record_s long, constant force amplitude for the
     SDOF and constant clamp-velocity amplitude for the damper; 'stepped_sine': STEPS log-spaced frequencies
-    over the band, record_s / STEPS each, at the sweep's force amplitudes (SDOF only: a clamp displacement
-    would jump at a step); 'noise': band-limited random noise over the band from rest, record_s long, at the
+    over the band, record_s / STEPS each, at the sweep's amplitudes (the damper's clamp: its frequency gliding
+    to each step's over GLIDE_S, so that its displacement, velocity and acceleration stay continuous); 'noise': band-limited random noise over the band from rest, record_s long, at the
     multisine's RMS levels; 'impedance': the damper's characteristic
     test, see write_impedance_case), the outputs recorded (None: the family's
     displacements; e.g. ("a",) or ("acc_x1", "acc_x2") for accelerometers) and which of the clamp's x, v,
@@ -139,7 +142,7 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     if truth is None and any(e not in family.withheld for e in effect.split("+")):
         raise ValueError(f"effect '{effect}' unknown for {family.model}; allowed: {', '.join(family.withheld)} "
                          "(or several joined by '+', or the truth's parameters given)")
-    allowed = EXCITATIONS if family.model == "SDOFBoucWen" else CLAMP_EXCITATIONS
+    allowed = EXCITATIONS if family.model == "SDOFBoucWen" else CLAMP_EXCITATIONS + ("stepped_sine",)
     if style.excitation not in allowed:
         raise ValueError(f"excitation '{style.excitation}' unknown for {family.model}; allowed: "
                          f"{', '.join(allowed)}")
@@ -162,7 +165,8 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
             signal = Excitation(2 if family.model == "SDOFBoucWen" else 4, level, f0, f1,
                                 (f1 - f0) / (style.record_s - 1.0), t_ramp=1.0)
         elif kind == "stepped_sine":
-            signal = SteppedSine(tuple(np.geomspace(f0, f1, STEPS)), style.record_s / STEPS, level)
+            clamp = dict(glide_s=GLIDE_S, velocity=True) if family.model != "SDOFBoucWen" else {}
+            signal = SteppedSine(tuple(np.geomspace(f0, f1, STEPS)), style.record_s / STEPS, level, **clamp)
         elif kind == "noise":
             signal = band_noise(f0, f1, level, seed)
         else:
@@ -228,8 +232,9 @@ def _excitation_meta(kind: str, signal, family: Family, level: float, spp: int, 
     if kind == "sweep":
         return {"kind": "linear_sweep", "f_start": f0, "f_end": f1, "amplitude": level}
     if kind == "stepped_sine":
+        glide = {"glide_s": signal.glide_s} if signal.glide_s else {}
         return {"kind": "stepped_sine", "frequencies": list(signal.frequencies), "dwell_s": signal.dwell_s,
-                "amplitude": level}
+                "amplitude": level, **glide}
     if kind == "noise":
         return {"kind": "random", "f_min": f0, "f_max": f1, "rms": level}
     return {"kind": "multisine", "samples_per_period": spp, "periods": periods, "f_min": f0, "f_max": f1,

@@ -60,6 +60,12 @@ RESULTS = {
                                                 "acc_x2 --motion a --seeds 0 && stockbridge diagnose --model damper "
                                                 "--cases results/lab_cases_design_acc --out "
                                                 "results/diagnose_lab_design_acc"),
+    "docs/results/diagnose_lab_design_step.md": ("results/diagnose_lab_design_step/summary.md",
+                                                 "stockbridge diagnose --model damper --make-datasets "
+                                                 "results/lab_cases_design_step --excitation stepped_sine --motion x "
+                                                 "--seeds 0 && stockbridge diagnose --model damper --cases "
+                                                 "results/lab_cases_design_step --out "
+                                                 "results/diagnose_lab_design_step"),
     "docs/results/diagnose_impedance.md": ("results/diagnose_impedance/summary.md",
                                            "stockbridge diagnose --model damper --make-datasets "
                                            "results/impedance_cases --excitation impedance --seeds 0 && "
