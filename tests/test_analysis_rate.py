@@ -5,7 +5,8 @@ to at least RATE_FACTOR times the highest excited frequency after a zero-phase a
 The filter is checked against analytic signals: whole periods of a multisine come back exactly on the coarser grid,
 a sine in the flat passband (below 0.6 of the new Nyquist frequency) within 1e-4 of its amplitude, a sine above the
 new Nyquist frequency attenuated by at least 100 dB. A diagnosis of an SDOF with a random cubic spring recorded by
-the CasADi reference at a random rate 42-55 times its sweep's top frequency is analysed at half that rate, names the spring and recovers its strength within 2 % and the linear stiffness within 1 %.
+the CasADi reference at a random rate 42-55 times its sweep's top frequency is analysed at half that rate, names the
+spring and recovers its strength within 2 % and the linear stiffness within 1 %.
 
 The FMU's drive grid follows the analysis rate (drive_upsample): a file faster than REFERENCE_HZ is driven on as many
 grid points a second as a file at that rate, and meets a closed-form response at least as well as one."""

@@ -1,6 +1,6 @@
 """Withheld-effect datasets (pyfit.gap.datasets) with a stepped sine and band-limited noise: what the files
 hold against the signal they were made from (a damper's clamp stepped sine: continuous motion at a constant
-velocity amplitude), and the excitations a family refuses."""
+velocity amplitude), and a constant-velocity stepped sine refused without a glide (its displacement would jump)."""
 import json
 
 import numpy as np
@@ -67,6 +67,11 @@ def test_a_clamp_stepped_sine_holds_each_velocity_amplitude_and_moves_the_clamp_
     for low, high in (("x_base", "v_base"), ("v_base", "a_base")):
         rest = np.diff(motion[low]) - dt * (motion[high][1:] + motion[high][:-1]) / 2
         assert np.max(np.abs(rest)) <= 1.1 * bound * dt * np.max(np.abs(motion[high])), low
+
+
+def test_a_constant_velocity_stepped_sine_needs_a_glide():
+    with pytest.raises(ValueError, match="velocity = True needs glide_s > 0"):
+        SteppedSine((5.0, 10.0), 1.0, 0.01, velocity=True)
 
 
 def _size(tmp_path, effect: str, truth: dict) -> dict:

@@ -94,7 +94,8 @@ class LabStyle:
     'sweep': a linear sweep over the family's band from rest, record_s long, constant force amplitude for the
     SDOF and constant clamp-velocity amplitude for the damper; 'stepped_sine': STEPS log-spaced frequencies
     over the band, record_s / STEPS each, at the sweep's amplitudes (the damper's clamp: its frequency gliding
-    to each step's over GLIDE_S, so that its displacement, velocity and acceleration stay continuous); 'noise': band-limited random noise over the band from rest, record_s long, at the
+    to each step's over GLIDE_S, so that its displacement, velocity and acceleration stay continuous);
+    'noise': band-limited random noise over the band from rest, record_s long, at the
     multisine's RMS levels; 'impedance': the damper's characteristic
     test, see write_impedance_case), the outputs recorded (None: the family's
     displacements; e.g. ("a",) or ("acc_x1", "acc_x2") for accelerometers) and which of the clamp's x, v,

@@ -131,8 +131,8 @@ class System:
     motion_inputs: tuple = ()  # displacement, velocity, acceleration inputs that must be consistent (or ())
     deflection: callable = None  # (simulated outputs, record) -> the element's deflection [m]
     damping: tuple = ()  # the damping parameters among `linear` the nominal's damping scan scales together
-    upsample: int = 4  # the FMU's drive grid = the sensor rate x this, for files at pyfit.gap.rate.REFERENCE_HZ (a faster
-    # file keeps the grid's points a second: rate.drive_upsample; DiagnoseConfig.upsample overrides it)
+    upsample: int = 4  # the FMU's drive grid = the sensor rate x this, for files at pyfit.gap.rate.REFERENCE_HZ (a
+    # faster file keeps the grid's points a second: rate.drive_upsample; DiagnoseConfig.upsample overrides it)
     smooth_inputs: bool = False  # drive the FMU with the inputs' cubic spline (pyfit.runtime.drive), not lines
     gains_free: bool = False  # every parameter is fitted from the data (a family that starts from the data, none
     # described): a channel's unknown gain (a voltage read in the model's unit) rescales them and no verdict
