@@ -50,3 +50,44 @@ def test_the_effects_outside_the_candidates_named_are_the_family_s():
     assert "4.7-6.1 Hz" in where and "a bolted joint's micro-slip" in where and "messenger" not in where
     assert "--candidates FILE.toml" in where
     assert "messenger's frequency-dependent loss" in FAMILY["damper"].outside
+
+
+def _held_out(fs: float = 500.0, seconds: float = 35.0, burst: tuple = (14.0, 16.0), burst_rms: float = 0.3,
+              noise: float = 0.008):
+    """A held-out record (a 12 Hz sine, unit RMS) and a model's simulation of it: noise everywhere and, from
+    burst[0] to burst[1] s, a misfit of burst_rms of the output's RMS (a model on the other steady state there)."""
+    import numpy as np
+
+    from pyfit.gap.simulate import Record
+
+    rng = np.random.default_rng(5)
+    t = np.arange(int(seconds * fs)) / fs
+    y = np.sqrt(2) * np.sin(2 * np.pi * 12.0 * t)
+    sim = y + noise * rng.normal(size=t.size)
+    inside = (t >= burst[0]) & (t < burst[1])
+    sim[inside] += burst_rms * np.sqrt(2) * np.sin(2 * np.pi * 12.0 * t[inside] + 1.0)
+    return {"level2": {"x1": sim}}, [Record("level2", "", 2.0, fs, {}, {"x1": y}, 0)]
+
+
+def test_a_misfit_confined_to_a_few_seconds_is_found_with_the_rest_of_the_record():
+    """A misfit of 0.3 of the output's RMS in 2 s of a 35 s record over noise of 0.008 elsewhere: 80 % of its
+    square lies in the two 1 s windows there (0.09 x 2 s against 6.4e-5 x 35 s: 98.8 %); outside them the NRMSE is
+    the noise's; the report says where and that the rest meets the criterion. A misfit spread over the record is
+    not confined."""
+    import numpy as np
+
+    from pyfit.gap.localise import confined_misfit
+    from pyfit.gap.report import _confined_lines
+
+    sims, held = _held_out()
+    found = confined_misfit(sims, held)
+    assert found is not None and found.windows == (("level2", 14.0, 16.0),)  # its two windows, joined
+    assert found.seconds == 2.0 and found.total_seconds == 35.0 and found.share > 0.8
+    assert abs(found.nrmse_rest - 0.008) < 0.0005  # the noise's standard deviation over a unit-RMS output
+    line = _confined_lines(found, explained_below=0.03)[0]
+    assert "lies in 2.0 s of the 35 s held out (level2 14.0-16.0 s)" in line
+    assert f"{found.nrmse_rest:.4f}, within the criterion" in line
+    assert _confined_lines(found, explained_below=0.005) == []  # the rest above the criterion: nothing said
+    spread, held = _held_out(burst=(0.0, 35.0), burst_rms=0.05)
+    assert confined_misfit(spread, held) is None
+    assert np.isclose(0.3 ** 2 * 2 / (0.3 ** 2 * 2 + 0.008 ** 2 * 33), found.share, atol=0.01)

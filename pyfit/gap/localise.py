@@ -7,6 +7,8 @@ say where the residual's energy lies.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.signal
 
@@ -18,6 +20,66 @@ LOOP_REGIONS = ("centre, loading", "centre, unloading", "tips, loading", "tips, 
 def nrmse(sim: dict, rec: Record) -> float:
     """sqrt(mean over channels of RMS(y_sim - y)^2 / RMS(y)^2)."""
     return float(np.sqrt(np.mean([np.mean((sim[k] - y) ** 2) / np.mean(y**2) for k, y in rec.outputs.items()])))
+
+
+@dataclass(frozen=True)
+class ConfinedMisfit:
+    """A model's held-out misfit confined to a few windows of time: the share of its squared NRMSE they hold,
+    their length and the held-out records' [s], the windows (file, start [s], end [s]; adjacent ones joined) and the
+    model's held-out NRMSE over the samples outside them."""
+
+    share: float
+    seconds: float
+    total_seconds: float
+    windows: tuple
+    nrmse_rest: float
+
+
+def confined_misfit(sims: dict, held: list[Record], window_s: float = 1.0, share: float = 0.8,
+                    most_time: float = 0.2) -> ConfinedMisfit | None:
+    """Whether a model's held-out misfit (its simulations `sims`, record name -> outputs) lies for at least `share`
+    of its squared NRMSE in windows of window_s seconds that together last at most `most_time` of the held-out
+    records: the fewest such windows, largest first, and the NRMSE over the rest; None when it is spread wider (or
+    a simulation failed)."""
+    if any(sims.get(rec.name) is None for rec in held):
+        return None
+    windows = []  # (contribution to the squared held-out NRMSE, record, first sample, end sample)
+    for rec in held:
+        sim, n, per = sims[rec.name], rec.n, max(1, int(round(window_s * rec.fs)))
+        ends = list(range(per, n - per // 2, per)) + [n]  # a short last window joins the one before it
+        for start, end in zip([0] + ends[:-1], ends):
+            part = np.mean([np.sum((sim[k][start:end] - y[start:end]) ** 2) / (n * np.mean(y ** 2))
+                            for k, y in rec.outputs.items()]) / len(held)
+            windows.append((part, rec, start, end))
+    whole = sum(w[0] for w in windows)
+    if whole <= 0:
+        return None
+    kept, held_share = [], 0.0
+    for w in sorted(windows, key=lambda w: -w[0]):
+        kept.append(w)
+        held_share += w[0] / whole
+        if held_share >= share:
+            break
+    seconds, total = sum((e - s) / r.fs for _, r, s, e in kept), sum(r.n / r.fs for r in held)
+    if seconds > most_time * total:
+        return None
+    rest = []
+    for rec in held:
+        mask = np.ones(rec.n, bool)
+        for _, r, start, end in kept:
+            if r is rec:
+                mask[start:end] = False
+        if mask.any():
+            rest.append(np.mean([np.mean((sims[rec.name][k][mask] - y[mask]) ** 2) / np.mean(y[mask] ** 2)
+                                 for k, y in rec.outputs.items()]))
+    shown = []  # adjacent windows of a record joined
+    for name, start, end in sorted((r.name, (r.first + s) / r.fs, (r.first + e) / r.fs) for _, r, s, e in kept):
+        if shown and shown[-1][0] == name and abs(shown[-1][2] - start) < 1e-9:
+            shown[-1] = (name, shown[-1][1], end)
+        else:
+            shown.append((name, start, end))
+    return ConfinedMisfit(float(held_share), float(seconds), float(total), tuple(shown),
+                          float(np.sqrt(np.mean(rest))))
 
 
 def _period_spectra(x: np.ndarray, spp: int) -> np.ndarray:

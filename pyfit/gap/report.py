@@ -98,18 +98,22 @@ POOR_LINEAR_NRMSE = 0.5  # a linear model at this NRMSE on a file reproduces 3/4
 
 
 def not_explained_lines(best: dict, ranking: list[dict], gap: dict, best_calibration: tuple[float, str],
-                        explained_below: float, cfg, outside: str) -> list[str]:
+                        explained_below: float, cfg, outside: str,
+                        confined: localise.ConfinedMisfit | None = None) -> list[str]:
     """The evidence of a gap no candidate explains: the best candidate against the criterion, each candidate's
     shrink, where the misfit left is largest, which effects outside the candidates are common in such systems
     (`outside`, System.outside) and what to try next. When the calibrated nominal misfits even its
     best calibration file by more than POOR_LINEAR_NRMSE and no refit removes `cfg.min_shrink_pct` of the
     held-out misfit, that is said first: every refit starts from that nominal and takes its ranges from it (its
-    stiffness, its deflection), so it can stop short of an effect that is there."""
+    stiffness, its deflection), so it can stop short of an effect that is there. When the best candidate's
+    held-out misfit lies in a few seconds (`confined`, localise.confined_misfit) and it meets the criterion over the
+    rest, that is said after its numbers."""
     lines = [f"best candidate {best['effect']}: held-out NRMSE {best['heldout_gap_after']:.4f}, shrink "
              f"{best['shrink_pct']:.1f} %; an explanation needs NRMSE <= {explained_below:.4f} (noise "
              f"floor {gap['noise_floor']:.4f}) and shrink >= {cfg.min_shrink_pct:.0f} %",
              "held-out shrink by candidate: " + ", ".join(f"{d['effect']} {d['shrink_pct']:.1f} %"
                                                           for d in ranking[:5]),
+             *_confined_lines(confined, explained_below),
              f"the misfit left is largest in the band {gap['worst_band_hz'][0]:.1f}-"
              f"{gap['worst_band_hz'][1]:.1f} Hz: an effect outside the candidates acts there ({outside}), or "
              "the description of the system (--nominal) is off there; an effect you can model can be declared "
@@ -126,6 +130,21 @@ def not_explained_lines(best: dict, ranking: list[dict], gap: dict, best_calibra
                         "Record a level where the response is closer to linear (a smaller one for a stiffening "
                         "spring, a larger one for a friction joint that sticks) and diagnose the files with it")
     return lines
+
+
+def _confined_lines(confined: localise.ConfinedMisfit | None, explained_below: float) -> list[str]:
+    """The best candidate's held-out misfit confined to a few windows while the rest meets the criterion: where,
+    and the two reasons a misfit is that confined (an effect acting there alone, or a response with two steady
+    states that a model close to the data follows the other one of)."""
+    if confined is None or confined.nrmse_rest > explained_below:
+        return []
+    where = ", ".join(f"{name} {t0:.1f}-{t1:.1f} s" for name, t0, t1 in confined.windows)
+    return [f"{100 * confined.share:.0f} % of the best candidate's held-out misfit lies in {confined.seconds:.1f} s "
+            f"of the {confined.total_seconds:.0f} s held out ({where}); over the rest its held-out NRMSE is "
+            f"{confined.nrmse_rest:.4f}, within the criterion. A misfit this confined comes from an effect that acts "
+            "there alone, or from a response with two steady states there (a hardening spring or a loop near a "
+            "resonance), of which a model this close to the data can follow the other one (most likely on a stepped "
+            "sine that dwells at a jump); a sweep through that range, or levels nearer the held-out one, tell which"]
 
 
 def _detection_lines(gap: dict, cfg) -> list[str]:
@@ -209,7 +228,7 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
                           "strongly with amplitude"]
     if significant and nominal_fits and not chosen and best:
         evidence = not_explained_lines(best, ranking, gap, (best_cal, best_file), explained_below, cfg,
-                                       system.outside)
+                                       system.outside, localise.confined_misfit(sims[best["effect"]], held))
     if chosen:
         sys_effect = system.effects[chosen]
         ranked_screen = sorted(screening, key=lambda k: -screening[k])
