@@ -77,17 +77,17 @@ def test_a_misfit_confined_to_a_few_seconds_is_found_with_the_rest_of_the_record
     import numpy as np
 
     from pyfit.gap.localise import confined_misfit
-    from pyfit.gap.report import _confined_lines
+    from pyfit.gap.report import confined_lines
 
     sims, held = _held_out()
     found = confined_misfit(sims, held)
     assert found is not None and found.windows == (("level2", 14.0, 16.0),)  # its two windows, joined
     assert found.seconds == 2.0 and found.total_seconds == 35.0 and found.share > 0.8
     assert abs(found.nrmse_rest - 0.008) < 0.0005  # the noise's standard deviation over a unit-RMS output
-    line = _confined_lines(found, explained_below=0.03)[0]
+    line = confined_lines(found, explained_below=0.03)[0]
     assert "lies in 2.0 s of the 35 s held out (level2 14.0-16.0 s)" in line
     assert f"{found.nrmse_rest:.4f}, within the criterion" in line
-    assert _confined_lines(found, explained_below=0.005) == []  # the rest above the criterion: nothing said
+    assert confined_lines(found, explained_below=0.005) == []  # the rest above the criterion: nothing said
     spread, held = _held_out(burst=(0.0, 35.0), burst_rms=0.05)
     assert confined_misfit(spread, held) is None
     assert np.isclose(0.3 ** 2 * 2 / (0.3 ** 2 * 2 + 0.008 ** 2 * 33), found.share, atol=0.01)

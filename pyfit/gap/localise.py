@@ -72,6 +72,8 @@ def confined_misfit(sims: dict, held: list[Record], window_s: float = 1.0, share
         if mask.any():
             rest.append(np.mean([np.mean((sims[rec.name][k][mask] - y[mask]) ** 2) / np.mean(y[mask] ** 2)
                                  for k, y in rec.outputs.items()]))
+    if not rest:  # every held-out sample lies in the windows (records far shorter than others)
+        return None
     shown = []  # adjacent windows of a record joined
     for name, start, end in sorted((r.name, (r.first + s) / r.fs, (r.first + e) / r.fs) for _, r, s, e in kept):
         if shown and shown[-1][0] == name and abs(shown[-1][2] - start) < 1e-9:

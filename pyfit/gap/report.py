@@ -113,7 +113,7 @@ def not_explained_lines(best: dict, ranking: list[dict], gap: dict, best_calibra
              f"floor {gap['noise_floor']:.4f}) and shrink >= {cfg.min_shrink_pct:.0f} %",
              "held-out shrink by candidate: " + ", ".join(f"{d['effect']} {d['shrink_pct']:.1f} %"
                                                           for d in ranking[:5]),
-             *_confined_lines(confined, explained_below),
+             *confined_lines(confined, explained_below),
              f"the misfit left is largest in the band {gap['worst_band_hz'][0]:.1f}-"
              f"{gap['worst_band_hz'][1]:.1f} Hz: an effect outside the candidates acts there ({outside}), or "
              "the description of the system (--nominal) is off there; an effect you can model can be declared "
@@ -132,7 +132,7 @@ def not_explained_lines(best: dict, ranking: list[dict], gap: dict, best_calibra
     return lines
 
 
-def _confined_lines(confined: localise.ConfinedMisfit | None, explained_below: float) -> list[str]:
+def confined_lines(confined: localise.ConfinedMisfit | None, explained_below: float) -> list[str]:
     """The best candidate's held-out misfit confined to a few windows while the rest meets the criterion: where,
     and the two reasons a misfit is that confined (an effect acting there alone, or a response with two steady
     states that a model close to the data follows the other one of)."""
