@@ -65,9 +65,7 @@ class Excitation:
         """C2-smooth ramp 10s^3 - 15s^4 + 6s^5 over t_ramp, then 1."""
         if self.t_ramp <= 0:
             return 1.0 + 0 * t
-        xp = _ops(t)
-        s = xp.minimum(t / self.t_ramp, 1.0)
-        return s**3 * (10 - 15 * s + 6 * s**2)
+        return smooth_step(_ops(t).minimum(t / self.t_ramp, 1.0))
 
     def __call__(self, t):
         """The signal at time(s) t (numpy array or CasADi expression)."""
@@ -234,7 +232,7 @@ class SteppedSine:
         if self.glide_s > 0:
             xp = _ops(t)
             f = np.asarray(self.frequencies, float)
-            return f[0] + sum((f[j] - f[j - 1]) * _smooth_step(xp.maximum(xp.minimum(
+            return f[0] + sum((f[j] - f[j - 1]) * smooth_step(xp.maximum(xp.minimum(
                 (t - j * self.dwell_s) / self.glide_s, 1.0), 0.0)) for j in range(1, len(f)))
         step = np.clip(np.floor(np.asarray(t, float) / self.dwell_s).astype(int), 0, len(self.frequencies) - 1)
         return np.asarray(self.frequencies, float)[step]
@@ -268,8 +266,9 @@ class SteppedSine:
         return amplitude * Excitation(1, t_ramp=self.t_ramp).envelope(t) * xp.sin(self.phase(t))
 
 
-def _smooth_step(c):
-    """The C2 ramp 10c^3 - 15c^4 + 6c^5 from 0 to 1 over c in [0, 1] (Excitation.envelope's)."""
+def smooth_step(c):
+    """The C2 ramp 10c^3 - 15c^4 + 6c^5 from 0 to 1 over c in [0, 1] (Excitation.envelope, SteppedSine's glide;
+    the Modelica Excitation source's env)."""
     return c**3 * (10 - 15 * c + 6 * c**2)
 
 
