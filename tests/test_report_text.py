@@ -91,3 +91,32 @@ def test_a_misfit_confined_to_a_few_seconds_is_found_with_the_rest_of_the_record
     spread, held = _held_out(burst=(0.0, 35.0), burst_rms=0.05)
     assert confined_misfit(spread, held) is None
     assert np.isclose(0.3 ** 2 * 2 / (0.3 ** 2 * 2 + 0.008 ** 2 * 33), found.share, atol=0.01)
+
+
+def test_the_prediction_band_is_asked_for_a_confined_misfit_of_a_model_that_removes_most_of_the_gap():
+    """report.needs_band: only for a report no candidate explains whose best model removes at least min_shrink_pct
+    of the gap and leaves a confined misfit with the rest within the criterion; band_lines states the fit's misfit,
+    where it lies and the band's best prediction."""
+    import dataclasses
+
+    from pyfit.gap.band import PredictionBand
+    from pyfit.gap.localise import confined_misfit
+    from pyfit.gap.report import band_lines, needs_band
+
+    sims, held = _held_out()
+    confined = confined_misfit(sims, held)
+    best = {"effect": "hysteresis + cubic_stiffness", "shrink_pct": 92.5, "heldout_gap_after": 0.037}
+    result = {"verdict": "gap not explained by the candidate effects", "ranking": [best], "explained_below": 0.0284,
+              "confined_misfit": dataclasses.asdict(confined)}
+    assert needs_band(result, 50.0) == "hysteresis + cubic_stiffness"
+    assert needs_band({**result, "explained_below": 0.005}, 50.0) is None  # the rest above the criterion
+    assert needs_band(result, 95.0) is None  # removes too little of the gap
+    assert needs_band({**result, "verdict": "gap explained by hysteresis"}, 50.0) is None
+    assert needs_band({**result, "verdict": "nominal model does not fit"}, 50.0) is None
+    assert needs_band({**result, "confined_misfit": None}, 50.0) is None  # a misfit spread over the record
+    band = PredictionBand("hysteresis + cubic_stiffness", 0.0053, 28, 23, {"k_bw1": 0.017}, {"k_bw1": 610.0},
+                          0.01293, 0.01290, 0.0109)
+    line, = band_lines({**best, "prediction_band": dataclasses.asdict(band)}, confined, 0.0284)
+    assert "held-out NRMSE 0.0370 is above the criterion 0.0284" in line
+    assert "in 2.0 s (level2 14.0-16.0 s)" in line
+    assert "within 0.53 % of the fit's 0.0129: 23 of 28 probed" in line and "held-out files at 0.0109" in line

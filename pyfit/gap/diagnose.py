@@ -21,7 +21,7 @@ from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
 from pyfit.runtime.examples import ensure_fmu
 from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read_toml
-from pyfit.gap import confidence, localise, selection, user_candidates
+from pyfit.gap import band, confidence, localise, selection, user_candidates
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, nominal_task, pinned, run_fit, screen
 from pyfit.gap.rate import AnalysisRate, analysis_rate, at_rate, drive_upsample
@@ -857,6 +857,13 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         clock.end("combinations of effects")
     result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
                              selected)
+    banded = report.needs_band(result, cfg.min_shrink_pct)
+    if banded:  # a confined misfit: does the best prediction the calibration files allow meet the criterion?
+        within = band.prediction_band(runner, fits[banded], system.effects[banded].derived(scale), cal, held,
+                                      cfg.upsample, system.lead_periods)
+        result = report.assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
+                                 selected, within)
+        clock.end("prediction band")
     result["level_order"] = data.order
     result["set_aside"] = {name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in data.aside.items()}
     result["voltage_channels"] = data.voltages

@@ -10,6 +10,7 @@ import numpy as np
 
 from pyfit.report import plots
 from pyfit.gap import confidence, localise, selection
+from pyfit.gap.band import PredictionBand
 from pyfit.gap import simulate as sim
 from pyfit.gap.rate import REFERENCE_HZ
 
@@ -147,6 +148,32 @@ def confined_lines(confined: localise.ConfinedMisfit | None, explained_below: fl
             "sine that dwells at a jump); a sweep through that range, or levels nearer the held-out one, tell which"]
 
 
+def needs_band(result: dict, min_shrink_pct: float) -> str | None:
+    """The model whose prediction band decides the verdict, or None: a report that no candidate explains, whose
+    best model removes at least `min_shrink_pct` of the gap and leaves its held-out misfit confined to a few
+    windows (localise.confined_misfit) with the rest within the criterion."""
+    confined, best = result["confined_misfit"], result["ranking"][0] if result["ranking"] else None
+    if not result["verdict"].startswith("gap not explained") or best is None or confined is None:
+        return None
+    if confined["nrmse_rest"] > result["explained_below"] or best["shrink_pct"] < min_shrink_pct:
+        return None
+    return best["effect"]
+
+
+def band_lines(best: dict, confined: localise.ConfinedMisfit | None, explained_below: float) -> list[str]:
+    """A model explained within its prediction band: where its fit misfits, and the band's best prediction."""
+    b = best["prediction_band"]
+    where = ", ".join(f"{name} {t0:.1f}-{t1:.1f} s" for name, t0, t1 in confined.windows) if confined else ""
+    return [f"at its fit the held-out NRMSE {best['heldout_gap_after']:.4f} is above the criterion "
+            f"{explained_below:.4f}" + (f", {100 * confined.share:.0f} % of it in {confined.seconds:.1f} s "
+                                        f"({where}), {confined.nrmse_rest:.4f} over the rest" if confined else "")
+            + f"; within its prediction band (the parameter sets whose calibration NRMSE is within "
+            f"{100 * b['tolerance']:.2f} % of the fit's {b['fit_calibration']:.4f}: {b['kept']} of {b['probed']} "
+            f"probed) the best predicts the held-out files at {b['heldout_nrmse']:.4f}. The calibration files do not "
+            "settle the prediction there: a response with two steady states (a hardening spring or a loop dwelling "
+            "near a resonance) that a change of the parameters too small to show on them moves from one to the other"]
+
+
 def _detection_lines(gap: dict, cfg) -> list[str]:
     """What the single refits said of a nominal misfit within the noise threshold (gap["detection"], set by the
     diagnosis when the nominal's test found no gap)."""
@@ -165,9 +192,11 @@ def _detection_lines(gap: dict, cfg) -> list[str]:
 
 
 def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, bands, scale, gap,
-             selected: str | None = None) -> dict:
+             selected: str | None = None, band: PredictionBand | None = None) -> dict:
     """The report: verdict, chosen effect, gap (where), ranking (which, how far), evidence. `selected`: the
-    model the forward selection kept; the other combinations it tried are reported but not chosen."""
+    model the forward selection kept; the other combinations it tried are reported but not chosen. `band`: the
+    prediction band of the best model (band.prediction_band, when `needs_band` says the report asks for it): that
+    model explains the data when the best prediction within its band meets the criterion."""
     floor, before, significant = gap["noise_floor"], gap["overall"], gap["significant"]
     afters = {name: selection.heldout_nrmse(sims[name], held) for name in fits}
     # the floor should the sensor noise grow with the level is an upper bound of the noise (it counts distortion
@@ -191,6 +220,11 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
     shrinks = {frozenset(d["members"]): d["shrink_pct"] for d in ranking}
     for d in ranking:
         d["explains"] = selection.explains(d["shrink_pct"], d["heldout_gap_after"], explained_below, cfg.min_shrink_pct)
+        if band is not None and band.effect == d["effect"]:
+            d["prediction_band"] = dataclasses.asdict(band)
+            d["explains_in_band"] = not d["explains"] and selection.explains(
+                d["shrink_pct"], band.heldout_nrmse, explained_below, cfg.min_shrink_pct)
+            d["explains"] = d["explains"] or d["explains_in_band"]
         if len(d["members"]) > 1:  # each member's share (selection.member_shares)
             d["member_shares_pct"] = selection.member_shares(d["members"], shrinks.get)
     for d in ranking:
@@ -199,6 +233,9 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
     # best-scoring one (combinations: only the one kept)
     ranking.sort(key=lambda d: (not d["kept"], not d["explains"], d["effect"] != selected, -d["score"]))
     best = ranking[0] if ranking else None
+    # where the best model's held-out misfit lies when it is above the criterion at its fit
+    confined = localise.confined_misfit(sims[best["effect"]], held) \
+        if significant and best and best["heldout_gap_after"] > explained_below else None
     best_cal, best_file = best_calibration_nrmse(gap)
     # the model fits when the nominal fits some calibration file, or (a strong amplitude-dependent effect, which
     # leaves no linear model fitting any level) a model with an effect fits the calibration files
@@ -228,13 +265,15 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
                           "strongly with amplitude"]
     if significant and nominal_fits and not chosen and best:
         evidence = not_explained_lines(best, ranking, gap, (best_cal, best_file), explained_below, cfg,
-                                       system.outside, localise.confined_misfit(sims[best["effect"]], held))
+                                       system.outside, confined)
     if chosen:
         sys_effect = system.effects[chosen]
         ranked_screen = sorted(screening, key=lambda k: -screening[k])
         evidence = [
             f"held-out NRMSE {before:.4f} -> {best['heldout_gap_after']:.4f} (noise floor {floor:.4f}): "
             f"shrink {best['shrink_pct']:.1f} %"]
+        if best.get("explains_in_band"):
+            evidence += band_lines(best, confined, explained_below)
         if len(best["members"]) > 1:
             evidence.append("share of the shrink: " + ", ".join(
                 f"{m} {v:.1f} %" for m, v in best["member_shares_pct"].items())
@@ -260,7 +299,7 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
                      + list(e.starts(scale))
                      for name, e in system.effects.items() if name in fits and e.starts(scale) and not e.members}
     return {"verdict": verdict, "chosen_effect": chosen, "significant": significant, "explained_below": explained_below,
-            "listed_starts": listed_starts,
+            "listed_starts": listed_starts, "confined_misfit": dataclasses.asdict(confined) if confined else None,
             "runner_up_close": bool(close), "gap": gap, "ranking": ranking, "evidence": evidence,
             "nominal": {"params": _free_values(nominal), "calibration_nrmse": nominal.calibration_nrmse,
                         "evaluations": nominal.evaluations},
