@@ -114,9 +114,10 @@ def test_the_prediction_band_is_asked_for_a_confined_misfit_of_a_model_that_remo
     assert needs_band({**result, "verdict": "gap explained by hysteresis"}, 50.0) is None
     assert needs_band({**result, "verdict": "nominal model does not fit"}, 50.0) is None
     assert needs_band({**result, "confined_misfit": None}, 50.0) is None  # a misfit spread over the record
-    band = PredictionBand("hysteresis + cubic_stiffness", 0.0053, 28, 23, {"k_bw1": 0.017}, {"k_bw1": 610.0},
+    band = PredictionBand("hysteresis + cubic_stiffness", 0.0053, 22, 22, 28, {"k_bw1": 0.017}, {"k_bw1": 610.0},
                           0.01293, 0.01290, 0.0109)
     line, = band_lines({**best, "prediction_band": dataclasses.asdict(band)}, confined, 0.0284)
     assert "held-out NRMSE 0.0370 is above the criterion 0.0284" in line
     assert "in 2.0 s (level2 14.0-16.0 s)" in line
-    assert "within 0.53 % of the fit's 0.0129: 23 of 28 probed" in line and "held-out files at 0.0109" in line
+    assert "within 0.53 % of the fit's 0.0129: 22 of the 22 ends of its axes" in line
+    assert "predicts the held-out files at 0.0109" in line

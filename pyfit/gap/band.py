@@ -4,8 +4,8 @@ its fit, and how well the best of them predicts the held-out files.
 A held-out file is a prediction. Where the model's response has two steady states (a hardening spring or a
 hysteretic loop dwelling near a resonance), a change of its parameters far too small to show on the
 calibration files can move the held-out prediction from one state to the other, so a model close to the
-truth can misfit a few seconds of a held-out file by far more than the noise. The band tells that case from a
-wrong model: a wrong model does not meet the criterion anywhere in the band.
+truth can misfit a few seconds of a held-out file by far more than the noise. A model whose structure misfits
+is hardly moved within its band: the band changes which state a prediction follows, not what the model can do.
 
 The band is the Gauss-Newton region around the fit in which the calibration residual's sum of squares rises by
 at most `tolerance(n)`: two standard errors of a white-noise record's NRMSE estimated from n samples,
@@ -39,14 +39,16 @@ def tolerance(samples: int) -> float:
 @dataclass(frozen=True)
 class PredictionBand:
     """The best held-out prediction within a model's band: the model (`effect`), the band's tolerance (relative
-    rise of the calibration NRMSE), the points probed and kept (within the band), how far each free parameter
+    rise of the calibration NRMSE), the axis ends (two per free parameter), those kept within the band and the
+    calibration evaluations that took (`probed`, back-offs included), how far each free parameter
     moves within the kept ones (`reach`: largest relative change), the best point's free parameter values (SI),
     its calibration NRMSE (the fit's: `fit_calibration`) and held-out NRMSE."""
 
     effect: str
     tolerance: float
-    probed: int
+    ends: int
     kept: int
+    probed: int
     reach: dict
     params: dict
     calibration_nrmse: float
@@ -102,6 +104,6 @@ def prediction_band(runner, fit, derived: tuple, cal, held, upsample: int, lead_
             best = (after, values, ssr)
     after, values, ssr = best
     moved = np.max([np.abs(np.clip(base * (1.0 + u), lo, hi) / base - 1.0) for u, _ in points], axis=0)
-    return PredictionBand(fit.effect, tol, probed, len(points), dict(zip(free, map(float, moved))),
+    return PredictionBand(fit.effect, tol, 2 * len(free), len(points) - 1, probed, dict(zip(free, map(float, moved))),
                           {n: float(values[n]) for n in fit.free},
                           float(np.sqrt(ssr / channels)), float(np.sqrt(ssr0 / channels)), float(after))
