@@ -79,7 +79,7 @@ def test_the_loop_starts_rank_alike_at_the_sensor_rate_and_upsampled(data_root, 
 
     def cost(start, upsample):
         p = attribute.with_derived({**task.fixed, **unit.values(unit.scaled(start))}, task.derived)
-        return float(np.sum(attribute._stacked(runner, task.records, p, upsample, task.lead_periods) ** 2))
+        return float(np.sum(attribute.stacked_residuals(runner, task.records, p, upsample, task.lead_periods) ** 2))
 
     fine = np.array([cost(s, task.upsample) for s in starts])
     coarse = np.array([cost(s, 1) for s in starts])

@@ -148,7 +148,7 @@ def test_damper_modal_starts_pair_every_resonance_with_every_peak(fmu_dir, measu
     lowest peak recovers EI (CasADi reference, 15 s sweep) and, driven by the sweep, fits it best."""
     from pyfit.analysis.excitation import Excitation, motion_with_derivatives
     from pyfit.gap import datasets
-    from pyfit.gap.attribute import _stacked
+    from pyfit.gap.attribute import stacked_residuals
     from pyfit.gap.diagnose import fmu_defaults
     from pyfit.gap.simulate import Record
     from pyfit.io.nominal import NominalModel
@@ -173,7 +173,7 @@ def test_damper_modal_starts_pair_every_resonance_with_every_peak(fmu_dir, measu
     starts = system.data_starts([rec], lambda p: linear_modes(fmu, p))
     measured("damper modal starts, the in-band resonance not the lowest: the first start's EI vs the truth "
              "(57 N·m², FMU start 10), relative", abs(starts[0]["EI"] / 57.0 - 1), 0.01)
-    costs = [float(np.sum(_stacked(runner, [rec], {**system.nominal_fixed, **s}, 2, 2) ** 2)) for s in starts]
+    costs = [float(np.sum(stacked_residuals(runner, [rec], {**system.nominal_fixed, **s}, 2, 2) ** 2)) for s in starts]
     assert int(np.argmin(costs)) == 0, [(round(s["EI"], 2), round(c, 4)) for s, c in zip(starts, costs)]
     # a nominal calibrated on records with a strong effect can end with its damping far off (an earlier campaign
     # case: beta_pd 55 x the truth): the effect refits' starts take only its resonances to name the peaks, and

@@ -33,7 +33,7 @@ def test_many_starts_are_ranked_coarsely_and_the_best_of_each_basin_scored_finel
         x = np.array([params["a"], params["b"]])
         return (x - truth) * (1.0 + 0.01 * (upsample == 1))  # the coarse grid scales the misfit: same order
 
-    monkeypatch.setattr(attribute, "_stacked", stacked)
+    monkeypatch.setattr(attribute, "stacked_residuals", stacked)
     monkeypatch.setattr(attribute, "FmuRunner", _NoRunner)
     grid = [{"a": a, "b": b} for a in np.linspace(0.0, 1.0, 9) for b in np.linspace(0.0, 1.0, 9)]  # 81 starts
     task = attribute.FitTask("x.fmu", (_RECORD,), {}, {"a": 0.5, "b": 0.5}, {"a": (0.0, 1.0), "b": (0.0, 1.0)}, "e",
@@ -72,7 +72,7 @@ def test_a_slow_basin_that_probes_second_goes_on_and_wins(monkeypatch):
         x = x0 + (goal - x0) * min(1.0, budget / 100)
         return OptimResult(x, float(np.sum(residuals(x) ** 2)), budget, "budget", [], 0.0)
 
-    monkeypatch.setattr(attribute, "_stacked", stacked)
+    monkeypatch.setattr(attribute, "stacked_residuals", stacked)
     monkeypatch.setattr(attribute, "polish", descent)
     monkeypatch.setattr(attribute, "FmuRunner", _NoRunner)
     task = attribute.FitTask("x.fmu", (_RECORD,), {}, {"a": 1.0}, {"a": (0.0, 1.0)}, "e", 1, 120, 4,

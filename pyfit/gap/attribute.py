@@ -87,8 +87,8 @@ class UnitScaling:
         return np.clip((v - self.lo) / (self.hi - self.lo), 0.0, 1.0)
 
 
-def _stacked(runner, records, params: dict, upsample: int, lead_periods: int, pool=None,
-             of=sim.residuals) -> np.ndarray:
+def stacked_residuals(runner, records, params: dict, upsample: int, lead_periods: int, pool=None,
+                      of=sim.residuals) -> np.ndarray:
     """The calibration records' residuals (`of`: sim.residuals, or sim.envelope_residuals), stacked. runner: one
     FmuRunner, or one per record when `pool` (a thread pool) simulates the records at once; the result is the
     same either way."""
@@ -141,7 +141,7 @@ def run_fit(task: FitTask) -> Fit:
     objective = sim.envelope_residuals if task.envelopes else sim.residuals
 
     def residuals(p, records=task.records, of=objective, upsample=task.upsample):
-        return _stacked(runner, records, p, upsample, task.lead_periods, pool, of)
+        return stacked_residuals(runner, records, p, upsample, task.lead_periods, pool, of)
 
     def cost(x, upsample=task.upsample):
         return float(np.sum(residuals(params(x), upsample=upsample) ** 2))
@@ -352,7 +352,7 @@ def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, 
     base = dict(nominal.params)
 
     def stacked(p):
-        return _stacked(runner, records, p, upsample, system.lead_periods)
+        return stacked_residuals(runner, records, p, upsample, system.lead_periods)
 
     r0 = stacked(base)
     J = []

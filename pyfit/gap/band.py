@@ -22,6 +22,7 @@ import numpy as np
 
 from pyfit.gap import simulate as sim
 from pyfit.gap import selection
+from pyfit.gap.attribute import stacked_residuals
 from pyfit.gap.systems import with_derived
 
 STEP = 1e-3  # relative step of the finite-difference Jacobian
@@ -56,12 +57,6 @@ class PredictionBand:
     heldout_nrmse: float
 
 
-def _ssr(runner, records, params: dict, upsample: int, lead_periods: int) -> np.ndarray:
-    """The calibration records' stacked residuals (sim.residuals) at `params`."""
-    return np.concatenate([sim.residuals(sim.simulate(runner, r, params, upsample, lead_periods), r)
-                           for r in records])
-
-
 def prediction_band(runner, fit, derived: tuple, cal, held, upsample: int, lead_periods: int) -> PredictionBand:
     """The band of `fit` (attribute.Fit; `derived`: its effect's rules for the parameters that follow the fitted
     ones) on the calibration records `cal`, and its best held-out NRMSE over `held` (the fit's own among them)."""
@@ -74,12 +69,12 @@ def prediction_band(runner, fit, derived: tuple, cal, held, upsample: int, lead_
     def at(u) -> dict:
         return with_derived({**fit.params, **dict(zip(free, np.clip(base * (1.0 + u), lo, hi)))}, derived)
 
-    r0 = _ssr(runner, cal, fit.params, upsample, lead_periods)
+    r0 = stacked_residuals(runner, cal, fit.params, upsample, lead_periods)
     ssr0 = float(r0 @ r0)
     channels = sum(sum(r.weights.get(k, 1.0) for k in r.outputs) for r in cal)
     tol = tolerance(sum(r.n * len(r.outputs) for r in cal))
     bound = ssr0 * (1.0 + tol) ** 2
-    J = np.column_stack([(_ssr(runner, cal, at(STEP * e), upsample, lead_periods) - r0) / STEP
+    J = np.column_stack([(stacked_residuals(runner, cal, at(STEP * e), upsample, lead_periods) - r0) / STEP
                          for e in np.eye(len(free))]) if free else np.zeros((len(r0), 0))
     lam, axes = np.linalg.eigh(J.T @ J) if free else (np.zeros(0), np.zeros((0, 0)))
     points, probed = [(np.zeros(len(free)), ssr0)], 0
@@ -90,7 +85,7 @@ def prediction_band(runner, fit, derived: tuple, cal, held, upsample: int, lead_
             u *= min(1.0, MAX_CHANGE / max(np.max(np.abs(u)), 1e-300))
             for _ in range(RETRIES + 1):
                 probed += 1
-                r = _ssr(runner, cal, at(u), upsample, lead_periods)
+                r = stacked_residuals(runner, cal, at(u), upsample, lead_periods)
                 if float(r @ r) <= bound:
                     points.append((u, float(r @ r)))
                     break

@@ -133,13 +133,18 @@ def not_explained_lines(best: dict, ranking: list[dict], gap: dict, best_calibra
     return lines
 
 
+def _windows_text(confined: localise.ConfinedMisfit) -> str:
+    """A confined misfit's windows as a reader sees them: 'file start-end s', comma separated."""
+    return ", ".join(f"{name} {t0:.1f}-{t1:.1f} s" for name, t0, t1 in confined.windows)
+
+
 def confined_lines(confined: localise.ConfinedMisfit | None, explained_below: float) -> list[str]:
     """The best candidate's held-out misfit confined to a few windows while the rest meets the criterion: where,
     and the two reasons a misfit is that confined (an effect acting there alone, or a response with two steady
     states that a model close to the data follows the other one of)."""
     if confined is None or confined.nrmse_rest > explained_below:
         return []
-    where = ", ".join(f"{name} {t0:.1f}-{t1:.1f} s" for name, t0, t1 in confined.windows)
+    where = _windows_text(confined)
     return [f"{100 * confined.share:.0f} % of the best candidate's held-out misfit lies in {confined.seconds:.1f} s "
             f"of the {confined.total_seconds:.0f} s held out ({where}); over the rest its held-out NRMSE is "
             f"{confined.nrmse_rest:.4f}, within the criterion. A misfit this confined comes from an effect that acts "
@@ -163,7 +168,7 @@ def needs_band(result: dict, min_shrink_pct: float) -> str | None:
 def band_lines(best: dict, confined: localise.ConfinedMisfit | None, explained_below: float) -> list[str]:
     """A model explained within its prediction band: where its fit misfits, and the band's best prediction."""
     b = best["prediction_band"]
-    where = ", ".join(f"{name} {t0:.1f}-{t1:.1f} s" for name, t0, t1 in confined.windows) if confined else ""
+    where = _windows_text(confined) if confined else ""
     return [f"at its fit the held-out NRMSE {best['heldout_gap_after']:.4f} is above the criterion "
             f"{explained_below:.4f}" + (f", {100 * confined.share:.0f} % of it in {confined.seconds:.1f} s "
                                         f"({where}), {confined.nrmse_rest:.4f} over the rest" if confined else "")
