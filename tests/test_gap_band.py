@@ -18,7 +18,7 @@ import scipy.optimize
 from pyfit.gap import band, datasets, selection
 from pyfit.gap import diagnose as dg
 from pyfit.gap import simulate as sim
-from pyfit.gap.attribute import Fit
+from pyfit.gap.attribute import Fit, stacked_residuals
 from pyfit.gap.systems import make_system
 from pyfit.runtime.examples import ensure_fmu
 from pyfit.runtime.fmu import FmuRunner
@@ -38,16 +38,12 @@ def duffing(tmp_path_factory):
     runner.close()
 
 
-def _ssr(runner, records, params, upsample):
-    r = np.concatenate([sim.residuals(sim.simulate(runner, rec, params, upsample), rec) for rec in records])
-    return float(r @ r)
-
-
 def test_the_band_reaches_as_far_as_the_calibration_allows(duffing, measured):
     runner, cal, held, linear, k3, upsample = duffing
 
     def cost(scale):
-        return _ssr(runner, cal, {**linear, "k3": k3 * scale}, upsample)
+        r = stacked_residuals(runner, cal, {**linear, "k3": k3 * scale}, upsample, 1)
+        return float(r @ r)
 
     best = scipy.optimize.minimize_scalar(cost, bounds=(0.9, 1.1), method="bounded",
                                           options={"xatol": 1e-6}).x
@@ -76,7 +72,7 @@ def test_a_wrong_model_is_not_moved_onto_the_data_within_its_band(duffing, measu
 
     def residuals(x):
         p = {**linear, **dict(zip(free, x))}
-        return np.concatenate([sim.residuals(sim.simulate(runner, rec, p, upsample), rec) for rec in cal])
+        return stacked_residuals(runner, cal, p, upsample, 1)
 
     x = scipy.optimize.least_squares(residuals, [linear["k"], linear["c"]], x_scale=[linear["k"], linear["c"]],
                                      max_nfev=60).x

@@ -175,8 +175,9 @@ def band_lines(best: dict, confined: localise.ConfinedMisfit | None, explained_b
             + f"; within its prediction band (the parameter sets whose calibration NRMSE is within "
             f"{100 * b['tolerance']:.2f} % of the fit's {b['fit_calibration']:.4f}: {b['kept']} of the {b['ends']} "
             f"ends of its axes) the best predicts the held-out files at {b['heldout_nrmse']:.4f}. The calibration "
-            "files do not settle the prediction there: a response with two steady states (a hardening spring or a loop dwelling "
-            "near a resonance) that a change of the parameters too small to show on them moves from one to the other"]
+            "files do not settle the prediction there: a response with two steady states (a hardening spring or a "
+            "loop dwelling near a resonance) that a change of the parameters too small to show on them moves from one "
+            "to the other"]
 
 
 def _detection_lines(gap: dict, cfg) -> list[str]:
