@@ -86,6 +86,9 @@ def on_campaign(folder: pathlib.Path):
     if not any(folder.glob("case*/outcome.json")):
         raise SystemExit(f"{folder}: no campaign cases (case*/outcome.json); run stockbridge diagnose --campaign first")
     cases = peers.on_campaign(folder)
+    if not cases:
+        raise SystemExit(f"{folder}: no SDOF case whose diagnosis ran (the equation-error methods need an SDOF's "
+                         "force and motion; a damper campaign has none)")
     report = BenchReport("peers_campaign", ROOT)
     summary = folder / "summary.md"
     made = re.search(r"^(.*?\)).*?command: (`[^`]+`)", summary.read_text(encoding="utf-8")) if summary.is_file() else None
