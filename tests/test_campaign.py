@@ -1,5 +1,6 @@
 """The validation campaign (pyfit.gap.campaign): its draw and its summary; the short campaign itself (20 random
 cases written by the CasADi reference and diagnosed on a Dask LocalCluster) is in the slow tier."""
+import dataclasses
 import json
 import pathlib
 import time
@@ -56,6 +57,26 @@ def test_drawn_dampers_span_the_catalogue_and_their_band_holds_two_resonances():
     loops = [c.truth for c in cases if "a_bw" in c.truth]
     assert loops and all(all(abs(lp["a_bw"] - s["a_bw"]) > 1e-6 and abs(lp["nu"] - s["nu"]) > 1e-6 for s in starts)
                          for lp in loops)
+
+def test_a_campaign_under_one_excitation_draws_the_same_cases_under_it(tmp_path):
+    """`--excitation` replaces each drawn case's excitation and nothing else (the cases a mixed campaign of the
+    same seed draws, e.g. a damper's under a clamp stepped sine); its command line and headline say so; an
+    excitation the family has not, or a calibration from one excitation only, is refused by name."""
+    mixed = campaign.draw(30, seed=2, model="damper")
+    stepped = campaign.draw(30, seed=2, model="damper", excitation="stepped_sine")
+    assert {c.excitation for c in stepped} == {"stepped_sine"} and "stepped_sine" not in {c.excitation for c in mixed}
+    assert [dataclasses.replace(c, excitation="stepped_sine") for c in mixed] == stepped
+    line = campaign.command(20, 0, "damper", excitation="stepped_sine", record_s=35.0)
+    assert line == "stockbridge diagnose --campaign 20 --campaign-seed 0 --model damper --excitation stepped_sine " \
+                   "--record-s 35"
+    head = campaign.markdown({**campaign.summarise([]), "cases": 0, "seed": 0, "record_s": 35.0, "where": "here",
+                              "wall_s": 60.0, "command": line, "excitation": "stepped_sine"}).splitlines()[0]
+    assert "every case's excitation a stepped sine, records 35 s" in head
+    with pytest.raises(ValueError, match="'impedance' unknown for --model damper; allowed: multisine, sweep, noise"):
+        campaign.draw(3, model="damper", excitation="impedance")
+    with pytest.raises(ValueError, match="--calibrate takes a campaign of every excitation"):
+        campaign.run(3, tmp_path, excitation="sweep", calibrate=True)
+
 
 
 @pytest.mark.parametrize("config, model", [(None, "sdof"), ("diagnose_nominal_threshold.toml", "sdof"),

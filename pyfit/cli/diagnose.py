@@ -48,9 +48,11 @@ def add_arguments(ap) -> None:
                     "(RMS of |Z_meas/Z_true - 1|; default: `uncertainty` of the test's sidecar)")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2], help="noise seeds of the null cases")
     ap.add_argument("--excitation", choices=["multisine", "sweep", "stepped_sine", "noise", "impedance"],
-                    default="multisine", help="with --make-datasets: steady multisine periods, a 35 s sweep, "
-                    "stepped sine (a damper's clamp gliding between its steps) or band-limited noise from rest, or "
-                    "(--model damper) an impedance test")
+                    help="with --make-datasets: steady multisine periods (the default), a sweep, stepped sine (a "
+                    "damper's clamp gliding between its steps) or band-limited noise from rest, or (--model damper) an "
+                    "impedance test; with --campaign: every case's excitation (default: drawn per case)")
+    ap.add_argument("--record-s", type=float, help="with --make-datasets or --campaign: the length [s] of a sweep, "
+                    "stepped-sine or noise record (default: 35 s; a campaign's 6 s)")
     ap.add_argument("--record", nargs="+", metavar="OUTPUT", help="with --make-datasets: the outputs recorded "
                     "(default: displacements; e.g. a, or acc_x1 acc_x2)")
     ap.add_argument("--campaign", type=count, metavar="N", help="validation campaign: draw N random cases of --model "
@@ -78,14 +80,16 @@ def run(args, ap) -> int:
 
     try:
         if args.make_datasets:
-            style = datasets.LabStyle(args.excitation, tuple(args.record) if args.record else None, args.motion)
+            style = datasets.LabStyle(args.excitation or "multisine", tuple(args.record) if args.record else None,
+                                      args.motion, args.record_s or datasets.LabStyle.record_s)
             base = load_nominal(args.nominal).fixed if args.nominal else None  # uncertain ones: FMU defaults
             for path in datasets.write_cases(args.make_datasets, args.model, args.seeds, style=style, base=base):
                 print(path)
             return 0
         if args.campaign:
             campaign.run(args.campaign, args.out, args.fmus, args.campaign_seed, args.workers or 2, args.scheduler,
-                         calibrate=args.calibrate, model=args.model, config=args.config)
+                         args.record_s or campaign.RECORD_S, calibrate=args.calibrate, model=args.model,
+                         config=args.config, excitation=args.excitation)
             print((pathlib.Path(args.out) / "summary.md").read_text())
             return 0
         cfg = load_config(args.config) if args.config else None

@@ -131,10 +131,21 @@ DAMPER_OUTPUTS = (("x1", "x2"), ("acc_x1", "acc_x2"), ("F_clamp", "acc_x1"), ("a
 DAMPER_MOTIONS = ("x", "a", "xva")  # clamp displacement, acceleration, or all three (a shaker controller)
 
 
-def draw(n: int, seed: int = 0, model: str = "sdof") -> list[Case]:
+def excitations_of(model: str) -> tuple[str, ...]:
+    """The excitations a campaign of `model` can fix for every case (`draw`'s `excitation`): the SDOF's
+    datasets.EXCITATIONS; the damper's clamp excitations and its stepped sine (drawn only when fixed: a clamp's
+    stepped sine glides between its STEPS dwells, which a record as short as RECORD_S leaves hardly a period of)."""
+    return datasets.EXCITATIONS if model == "sdof" else datasets.CLAMP_EXCITATIONS + ("stepped_sine",)
+
+
+def draw(n: int, seed: int = 0, model: str = "sdof", excitation: str | None = None) -> list[Case]:
     """n cases of `model` ('sdof' or 'damper') drawn with numpy's generator from `seed` (the same n, seed and
     model give the same cases). The sizes come from a generator of their own (seeded with (seed, 1)), so that
-    every other draw of a case is the one the same seed gave before sizes were drawn."""
+    every other draw of a case is the one the same seed gave before sizes were drawn. `excitation` (one of
+    excitations_of(model)) replaces every case's drawn excitation, after it is drawn: the same cases otherwise."""
+    if excitation is not None and excitation not in excitations_of(model):
+        raise ValueError(f"campaign excitation '{excitation}' unknown for --model {model}; allowed: "
+                         f"{', '.join(excitations_of(model))}")
     rng, size_rng = np.random.default_rng(seed), np.random.default_rng((seed, 1))
     cases = []
     for i in range(n):
@@ -153,7 +164,7 @@ def draw(n: int, seed: int = 0, model: str = "sdof") -> list[Case]:
         cases.append(Case(i, withheld, truth, str(rng.choice(datasets.CLAMP_EXCITATIONS)),
                           DAMPER_OUTPUTS[rng.integers(len(DAMPER_OUTPUTS))], int(rng.integers(1 << 30)), "damper",
                           base, str(rng.choice(DAMPER_MOTIONS)), band, sizes))
-    return cases
+    return [dataclasses.replace(c, excitation=excitation) for c in cases] if excitation else cases
 
 
 @dataclass(frozen=True)
@@ -244,27 +255,34 @@ def stated_with(outcome: dict, calibration: dict | None) -> float | None:
     return stated["rate"] if stated else None
 
 
-def command(n: int, seed: int, model: str = "sdof", config: str | None = None) -> str:
+def command(n: int, seed: int, model: str = "sdof", config: str | None = None, excitation: str | None = None,
+            record_s: float = RECORD_S) -> str:
     """The command line that runs this campaign."""
     return (f"stockbridge diagnose --campaign {n} --campaign-seed {seed}" + ("" if model == "sdof" else
                                                                             f" --model {model}")
+            + (f" --excitation {excitation}" if excitation else "")
+            + (f" --record-s {record_s:g}" if record_s != RECORD_S else "")
             + (f" --config {config}" if config else ""))
 
 
 def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=None, record_s: float = RECORD_S,
-        progress: bool = True, calibrate: bool = False, model: str = "sdof", config: str | None = None) -> dict:
-    """Draw n cases of `model` and diagnose them: on `scheduler` (a Dask scheduler address) when given, else on
+        progress: bool = True, calibrate: bool = False, model: str = "sdof", config: str | None = None,
+        excitation: str | None = None) -> dict:
+    """Draw n cases of `model` (every one under `excitation` when given: draw) and diagnose them: on `scheduler` (a Dask scheduler address) when given, else on
     a Dask LocalCluster of `workers` single-threaded processes. Writes OUT/summary.md and OUT/summary.json (a
     campaign whose every case is stored is summarised again, with the wall time of the run that diagnosed them);
     with `calibrate`, its hit rates become the package's confidence calibration of `model` with its settings
     (pyfit.gap.confidence), and the summary states every report's confidence with it (in-sample); `config`: a
     TOML file of diagnosis settings (pyfit.gap.diagnose.load_config; default: the defaults)."""
+    if calibrate and excitation:
+        raise ValueError("--calibrate takes a campaign of every excitation (a report's confidence is read from it "
+                         "whatever its records); drop --excitation")
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     cfg = load_config(config) if config else DiagnoseConfig()
     settings = confidence.settings_of(asdict(cfg))
     stated_from = confidence.load(settings, model)
-    jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg) for c in draw(n, seed, model)]
+    jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg) for c in draw(n, seed, model, excitation)]
     # cases an earlier run finished (interrupted, or a rerun of only some cases): read, not diagnosed again, so this
     # run's wall time does not cover them
     resumed = sum((out / f"case{j.case.index:04d}" / "outcome.json").is_file() for j in jobs)
@@ -289,14 +307,15 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
         # before it): with this run's, a full run's wall time at most
         run_by["earlier_wall_s"] = earlier["wall_s"] + earlier.get("earlier_wall_s", 0.0)
     if calibrate:
-        stated_from = confidence.calibration_of(outcomes, command(n, seed, model, config), seed, settings, model)
+        stated_from = confidence.calibration_of(outcomes, command(n, seed, model, config, excitation, record_s),
+                                                seed, settings, model)
         confidence.write(stated_from)
     # every report's confidence as stated with the calibration this run reads or writes (an outcome read from an
     # earlier run holds the one that run read)
     outcomes = [{**o, "stated": stated_with(o, stated_from)} for o in outcomes]
     summary = summarise(outcomes)
-    summary.update({"cases": n, "seed": seed, "record_s": record_s, **run_by,
-                    "command": command(n, seed, model, config),
+    summary.update({"cases": n, "seed": seed, "record_s": record_s, "excitation": excitation, **run_by,
+                    "command": command(n, seed, model, config, excitation, record_s),
                     "model": model,
                     "stated_from": {k: stated_from[k] for k in ("source", "seed", "cases")} if stated_from else None})
     (out / "summary.json").write_text(json.dumps({**summary, "outcomes": outcomes}, indent=1, default=float))
@@ -416,8 +435,9 @@ def markdown(s: dict) -> str:
     system = {"sdof": "SDOF", "damper": "damper (random geometry)"}[s.get("model", "sdof")]
     diagnosed = s["cases"] - s.get("resumed", 0)  # by this run
     lo, hi = sizing.SIZE_RANGE
-    lines = [f"{s['cases']} {system} cases (seed {s['seed']}, records {s['record_s']:g} s, each withheld effect at "
-             f"{lo:g}–{hi:g} × the sensor noise), {s['where']}: wall "
+    every = f", every case's excitation a {s['excitation'].replace('_', ' ')}" if s.get("excitation") else ""
+    lines = [f"{s['cases']} {system} cases (seed {s['seed']}{every}, records {s['record_s']:g} s, each withheld "
+             f"effect at {lo:g}–{hi:g} × the sensor noise), {s['where']}: wall "
              f"{s['wall_s'] / 60:.1f} min"
              + (f" for the {diagnosed} case{'' if diagnosed == 1 else 's'} this run diagnosed ({s['resumed']} read "
                 "from an earlier run" + (f", whose runs took {s['earlier_wall_s'] / 60:.1f} min: a full run takes "
