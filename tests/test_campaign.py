@@ -39,8 +39,8 @@ def test_the_draw_is_reproducible_and_spans_nulls_singles_and_pairs():
 
 def test_drawn_dampers_span_the_catalogue_and_their_band_holds_two_resonances():
     """Damper cases: geometry within the catalogue ranges, the test band around the two lowest resonances of the
-    reference model, every sensor set and clamp motion, no stepped sine (a clamp displacement cannot step), loop
-    shapes away from the candidate's starts."""
+    reference model, every sensor set and clamp motion, no stepped sine unless asked for (its dwells need longer
+    records than a campaign's), loop shapes away from the candidate's starts."""
     from pyfit.reference.models import damper_modes_hz
 
     cases = campaign.draw(60, seed=5, model="damper")
@@ -61,7 +61,8 @@ def test_drawn_dampers_span_the_catalogue_and_their_band_holds_two_resonances():
 def test_a_campaign_under_one_excitation_draws_the_same_cases_under_it(tmp_path):
     """`--excitation` replaces each drawn case's excitation and nothing else (the cases a mixed campaign of the
     same seed draws, e.g. a damper's under a clamp stepped sine); its command line and headline say so; an
-    excitation the family has not, or a calibration from one excitation only, is refused by name."""
+    excitation the family has not, a record too short for it, or a calibration from one excitation only, is refused
+    by name."""
     mixed = campaign.draw(30, seed=2, model="damper")
     stepped = campaign.draw(30, seed=2, model="damper", excitation="stepped_sine")
     assert {c.excitation for c in stepped} == {"stepped_sine"} and "stepped_sine" not in {c.excitation for c in mixed}
@@ -71,11 +72,16 @@ def test_a_campaign_under_one_excitation_draws_the_same_cases_under_it(tmp_path)
                    "--record-s 35"
     head = campaign.markdown({**campaign.summarise([]), "cases": 0, "seed": 0, "record_s": 35.0, "where": "here",
                               "wall_s": 60.0, "command": line, "excitation": "stepped_sine"}).splitlines()[0]
-    assert "every case's excitation a stepped sine, records 35 s" in head
+    assert "every case's excitation: stepped sine, records 35 s" in head
     with pytest.raises(ValueError, match="'impedance' unknown for --model damper; allowed: multisine, sweep, noise"):
         campaign.draw(3, model="damper", excitation="impedance")
     with pytest.raises(ValueError, match="--calibrate takes a campaign of every excitation"):
         campaign.run(3, tmp_path, excitation="sweep", calibrate=True)
+    # a record too short for the excitation: refused before anything is written (16 dwells of a 3 s record would
+    # be shorter than the 0.2 s glide into each)
+    with pytest.raises(ValueError, match=r"--record-s\) 3 s: a stepped_sine record must be longer than 3.2 s"):
+        campaign.run(3, tmp_path / "short", model="damper", excitation="stepped_sine", record_s=3.0)
+    assert not (tmp_path / "short").exists()
 
 
 
@@ -159,6 +165,11 @@ def test_the_headline_states_the_size_range_the_summary_was_drawn_at(tmp_path):
     lo, hi = sizing.SIZE_RANGE
     line = generated._campaign_headline(tmp_path)
     assert f"each at {lo:g}–{hi:g} × the sensor noise" in line and "in 100 %" in line
+    # the damper campaign's line, from its own summary, points to its own section
+    (tmp_path / "campaign_damper.md").write_text(text, encoding="utf-8")
+    damper = generated._campaign_headline(tmp_path, "campaign_damper.md", "Damper campaign", "catalogue dampers",
+                                          "geometry drawn", "damper-cases", first=False)
+    assert damper.startswith("- **Damper campaign**: on 1 random catalogue dampers") and "#damper-cases" in damper
 
 
 def test_the_summary_times_nulls_singles_and_pairs_apart():

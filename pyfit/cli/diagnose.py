@@ -20,6 +20,7 @@ EXAMPLE = """examples:
   stockbridge diagnose --benchmark --config configs/diagnose_benchmark.toml # official Bouc-Wen signals
   stockbridge diagnose --campaign 200 --out results/campaign                # random truths, a Dask LocalCluster
   stockbridge diagnose --campaign 200 --scheduler tcp://10.0.0.5:8786       # ... on a Dask cluster
+  stockbridge diagnose --campaign 40 --model damper --excitation stepped_sine --record-s 35  # one excitation
 
 A dataset is a folder of measurement files (CSV + TOML sidecar, one per level; docs: measurement files).
 Writes report.md (verdict, ranked effects, shrink on held-out files), report.json and figures into --out."""

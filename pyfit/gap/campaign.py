@@ -268,8 +268,8 @@ def command(n: int, seed: int, model: str = "sdof", config: str | None = None, e
 def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=None, record_s: float = RECORD_S,
         progress: bool = True, calibrate: bool = False, model: str = "sdof", config: str | None = None,
         excitation: str | None = None) -> dict:
-    """Draw n cases of `model` (every one under `excitation` when given: draw) and diagnose them: on `scheduler` (a Dask scheduler address) when given, else on
-    a Dask LocalCluster of `workers` single-threaded processes. Writes OUT/summary.md and OUT/summary.json (a
+    """Draw n cases of `model` (every one under `excitation` when given: draw) and diagnose them: on `scheduler`
+    (a Dask scheduler address) when given, else on a Dask LocalCluster of `workers` single-threaded processes. Writes OUT/summary.md and OUT/summary.json (a
     campaign whose every case is stored is summarised again, with the wall time of the run that diagnosed them);
     with `calibrate`, its hit rates become the package's confidence calibration of `model` with its settings
     (pyfit.gap.confidence), and the summary states every report's confidence with it (in-sample); `config`: a
@@ -277,12 +277,15 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     if calibrate and excitation:
         raise ValueError("--calibrate takes a campaign of every excitation (a report's confidence is read from it "
                          "whatever its records); drop --excitation")
+    cases = draw(n, seed, model, excitation)
+    for kind in {c.excitation for c in cases}:  # a record too short for an excitation: refused here, not per case
+        datasets.LabStyle(kind, record_s=record_s)
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     cfg = load_config(config) if config else DiagnoseConfig()
     settings = confidence.settings_of(asdict(cfg))
     stated_from = confidence.load(settings, model)
-    jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg) for c in draw(n, seed, model, excitation)]
+    jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg) for c in cases]
     # cases an earlier run finished (interrupted, or a rerun of only some cases): read, not diagnosed again, so this
     # run's wall time does not cover them
     resumed = sum((out / f"case{j.case.index:04d}" / "outcome.json").is_file() for j in jobs)
@@ -435,7 +438,7 @@ def markdown(s: dict) -> str:
     system = {"sdof": "SDOF", "damper": "damper (random geometry)"}[s.get("model", "sdof")]
     diagnosed = s["cases"] - s.get("resumed", 0)  # by this run
     lo, hi = sizing.SIZE_RANGE
-    every = f", every case's excitation a {s['excitation'].replace('_', ' ')}" if s.get("excitation") else ""
+    every = f", every case's excitation: {s['excitation'].replace('_', ' ')}" if s.get("excitation") else ""
     lines = [f"{s['cases']} {system} cases (seed {s['seed']}{every}, records {s['record_s']:g} s, each withheld "
              f"effect at {lo:g}–{hi:g} × the sensor noise), {s['where']}: wall "
              f"{s['wall_s'] / 60:.1f} min"

@@ -106,6 +106,14 @@ class LabStyle:
     motion: str = "xva"
     record_s: float = 35.0  # length of a sweep, stepped-sine or noise record [s]
 
+    def __post_init__(self):  # a multisine's length is its periods'
+        stepped = self.excitation == "stepped_sine"
+        shortest, why = ((STEPS * GLIDE_S, f"each of its {STEPS} dwells longer than a clamp's {GLIDE_S:g} s glide")
+                         if stepped else (1.0, "a sweep's ramp alone takes 1 s"))
+        if self.excitation != "multisine" and not self.record_s > shortest:
+            raise ValueError(f"record length (record_s, --record-s) {self.record_s:g} s: a {self.excitation} record "
+                             f"must be longer than {shortest:g} s ({why})")
+
 
 def _truth_params(family: Family, effect: str, base: dict, truth: dict | None = None) -> dict:
     """Truth = linear + base (a described system) + the effect(s) ('a+b': several), or + `truth` when given

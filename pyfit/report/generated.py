@@ -96,6 +96,9 @@ RESULTS = {
     "docs/results/campaign_damper_calibration.md": ("results/campaign_damper_calibration/summary.md",
                                                     "stockbridge diagnose --campaign 100 --campaign-seed 1 --model "
                                                     "damper --calibrate --out results/campaign_damper_calibration"),
+    "docs/results/campaign_damper_step.md": ("results/campaign_damper_step/summary.md",
+                                             "stockbridge diagnose --campaign 40 --model damper --excitation "
+                                             "stepped_sine --record-s 35 --out results/campaign_damper_step"),
     "docs/results/bench_peers_fit.md": ("results/bench/peers_fit.md", "python bench/peers_fit.py"),
     "docs/results/bench_peers_diagnosis.md": ("results/bench/peers_diagnosis.md", "python bench/peers_diagnosis.py"),
     "docs/results/bench_peers_campaign.md": ("results/bench/peers_campaign.md",
@@ -221,9 +224,13 @@ def _peers_headline(res: pathlib.Path) -> str | None:
             f"{best[7]} ([validation](../validation.md#side-by-side-with-the-tools-a-user-would-pick-instead)).")
 
 
-def _campaign_headline(res: pathlib.Path) -> str | None:
-    """The validation campaign's accuracy, from campaign.md (None without it)."""
-    path = res / "campaign.md"
+def _campaign_headline(res: pathlib.Path, name: str = "campaign.md", label: str = "Validation campaign",
+                       cases: str = "SDOF cases", drawn: str = "random loop shapes, excitations, sensors",
+                       anchor: str = "validation-campaign", first: bool = True) -> str | None:
+    """A validation campaign's accuracy, from its summary `name` (None without it): the SDOF campaign's by default;
+    `cases`, `drawn` and `anchor` say what it drew and where the validation page shows it; `first`: the line that
+    says which misses the data cannot decide (a later line refers to it)."""
+    path = res / name
     if not path.is_file():
         return None
     text = path.read_text(encoding="utf-8")
@@ -233,14 +240,15 @@ def _campaign_headline(res: pathlib.Path) -> str | None:
         return None
     decided = re.search(r"Top-1 accuracy on the (\d+) cases detected and decided by the data: (\d+) %", text)
     sizes = re.search(r"each withheld effect at ([\d.]+–[\d.]+) × the sensor noise", text)
-    return (f"- **Validation campaign**: on {m[1]} random SDOF cases with one or two withheld effects ("
+    return (f"- **{label}**: on {m[1]} random {cases} with one or two withheld effects ("
             + (f"each at {sizes[1]} × the sensor noise; " if sizes else "")
-            + "random loop shapes, excitations, sensors) the diagnosis names exactly what was withheld in "
+            + f"{drawn}) the diagnosis names exactly what was withheld in "
             f"{m[2]} %"
             + (f", and in {decided[2]} % of the {decided[1]} left when the misses the data cannot decide are set "
-               "aside (a gap within the noise, the named model fitting the held-out files at least as well as "
-               "the truth, or the truth itself removing too little of the gap to be named)" if decided else "")
-            + f"; false alarms: {m[4]} of {m[3]} null cases ([validation](../validation.md#validation-campaign)).")
+               "aside" + (" (a gap within the noise, the named model fitting the held-out files at least as well as "
+                          "the truth, or the truth itself removing too little of the gap to be named)" if first else
+                          "") if decided else "")
+            + f"; false alarms: {m[4]} of {m[3]} null cases ([validation](../validation.md#{anchor})).")
 
 
 def headlines(root: pathlib.Path) -> pathlib.Path:
@@ -260,6 +268,9 @@ def headlines(root: pathlib.Path) -> pathlib.Path:
         f"{_cases(root, 'diagnose_lab')} lab-style SDOF sweeps recorded by an accelerometer, a skew between the "
         "channels included ([diagnosis](../guide/diagnose.md)).",
         _campaign_headline(res),
+        _campaign_headline(res, "campaign_damper.md", "Damper campaign", "catalogue dampers",
+                           "masses, arms, offsets, messenger stiffness and damping, loop shapes, excitations and "
+                           "sensors drawn; the geometry described to the diagnosis", "damper-cases", first=False),
         _peers_headline(res),
         f"- **Damper physics**: the damper FMU's clamp power matches a harmonic solution of independently "
         f"assembled 6-DOF matrices to a relative error of "
