@@ -114,6 +114,22 @@ def test_a_campaign_read_back_states_every_report_with_the_calibration_it_reads(
         assert o["stated"] == confidence.stated(o["verdict"], chosen, o["top_shrink_pct"], package)["rate"] != 0.01
 
 
+def test_a_folder_holding_another_campaign_s_cases_is_refused_not_read_as_this_one_s(tmp_path):
+    """A finished case is read, not diagnosed again, so an outcome of another draw (another --campaign-seed,
+    --model or --excitation given the same --out) would be summarised as this run's case: refused by name."""
+    from dataclasses import asdict
+
+    case = campaign.draw(1, seed=0)[0]
+    (tmp_path / "case0000").mkdir()
+    stored = tmp_path / "case0000" / "outcome.json"
+    stored.write_text(json.dumps({"named": "none", "withheld": case.withheld, "case": asdict(case)}))
+    other = campaign.draw(1, seed=1)[0]
+    with pytest.raises(ValueError, match=r"case0000/outcome.json: a case of another campaign \(.*noise seed "
+                                         rf"{case.seed}.*this run draws .*noise seed {other.seed}"):
+        campaign.run(1, tmp_path, seed=1, progress=False)
+    assert not (tmp_path / "summary.json").exists()
+
+
 def test_no_drawn_loop_sits_at_a_start_of_the_candidate():
     scale = Scale(1e-3, 0.2, 1e5, {})
     effect = SDOF_EFFECTS["hysteresis"]

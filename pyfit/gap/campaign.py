@@ -288,7 +288,11 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg) for c in cases]
     # cases an earlier run finished (interrupted, or a rerun of only some cases): read, not diagnosed again, so this
     # run's wall time does not cover them
-    resumed = sum((out / f"case{j.case.index:04d}" / "outcome.json").is_file() for j in jobs)
+    stored = [out / f"case{c.index:04d}" / "outcome.json" for c in cases]
+    for path, c in zip(stored, cases):
+        if path.is_file():
+            _check_same_case(path, c)
+    resumed = sum(path.is_file() for path in stored)
     t0 = time.perf_counter()
     if scheduler is None:
         from distributed import Client, LocalCluster
@@ -324,6 +328,22 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     (out / "summary.json").write_text(json.dumps({**summary, "outcomes": outcomes}, indent=1, default=float))
     (out / "summary.md").write_text(markdown(summary))
     return summary
+
+
+IDENTITY = ("model", "withheld", "excitation", "outputs", "seed")  # what tells one drawn case from another
+
+
+def _check_same_case(path: pathlib.Path, case: Case) -> None:
+    """An outcome stored in the campaign's folder must be of the case this run draws there (not of another
+    --campaign-seed, --model or --excitation written to the same --out), else it would be read as this one's."""
+    was = json.loads(path.read_text()).get("case", {})
+    now = json.loads(json.dumps(asdict(case)))
+    differ = [k for k in IDENTITY if k in was and was[k] != now[k]]
+    if differ:
+        def named(values):
+            return ", ".join(f"{'noise seed' if k == 'seed' else k} {values[k]!r}" for k in differ)
+        raise ValueError(f"{path}: a case of another campaign ({named(was)}; this run draws {named(now)} there): "
+                         "give another --out, or the options that campaign ran with")
 
 
 def _tally(outcomes: list[dict], size: int) -> dict:
