@@ -131,21 +131,16 @@ DAMPER_OUTPUTS = (("x1", "x2"), ("acc_x1", "acc_x2"), ("F_clamp", "acc_x1"), ("a
 DAMPER_MOTIONS = ("x", "a", "xva")  # clamp displacement, acceleration, or all three (a shaker controller)
 
 
-def excitations_of(model: str) -> tuple[str, ...]:
-    """The excitations a campaign of `model` can fix for every case (`draw`'s `excitation`): the SDOF's
-    datasets.EXCITATIONS; the damper's clamp excitations and its stepped sine (drawn only when fixed: a clamp's
-    stepped sine glides between its STEPS dwells, which a record as short as RECORD_S leaves hardly a period of)."""
-    return datasets.EXCITATIONS if model == "sdof" else datasets.CLAMP_EXCITATIONS + ("stepped_sine",)
-
-
 def draw(n: int, seed: int = 0, model: str = "sdof", excitation: str | None = None) -> list[Case]:
     """n cases of `model` ('sdof' or 'damper') drawn with numpy's generator from `seed` (the same n, seed and
     model give the same cases). The sizes come from a generator of their own (seeded with (seed, 1)), so that
     every other draw of a case is the one the same seed gave before sizes were drawn. `excitation` (one of
-    excitations_of(model)) replaces every case's drawn excitation, after it is drawn: the same cases otherwise."""
-    if excitation is not None and excitation not in excitations_of(model):
+    datasets.excitations of the family) replaces every case's drawn excitation, after it is drawn: the same cases
+    otherwise."""
+    allowed = datasets.excitations(datasets.FAMILIES[model])
+    if excitation is not None and excitation not in allowed:
         raise ValueError(f"campaign excitation '{excitation}' unknown for --model {model}; allowed: "
-                         f"{', '.join(excitations_of(model))}")
+                         f"{', '.join(allowed)}")
     rng, size_rng = np.random.default_rng(seed), np.random.default_rng((seed, 1))
     cases = []
     for i in range(n):

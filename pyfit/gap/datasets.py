@@ -115,6 +115,12 @@ class LabStyle:
                              f"must be longer than {shortest:g} s ({why})")
 
 
+def excitations(family: Family) -> tuple[str, ...]:
+    """The excitations write_dataset records `family` under: the SDOF's EXCITATIONS; a damper's clamp excitations
+    and its stepped sine (a campaign draws that one only when asked for: its glides need longer records)."""
+    return EXCITATIONS if family.model == "SDOFBoucWen" else CLAMP_EXCITATIONS + ("stepped_sine",)
+
+
 def _truth_params(family: Family, effect: str, base: dict, truth: dict | None = None) -> dict:
     """Truth = linear + base (a described system) + the effect(s) ('a+b': several), or + `truth` when given
     (e.g. parameters drawn at random across the family); an effect value may be a function of the system's
@@ -151,7 +157,7 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     if truth is None and any(e not in family.withheld for e in effect.split("+")):
         raise ValueError(f"effect '{effect}' unknown for {family.model}; allowed: {', '.join(family.withheld)} "
                          "(or several joined by '+', or the truth's parameters given)")
-    allowed = EXCITATIONS if family.model == "SDOFBoucWen" else CLAMP_EXCITATIONS + ("stepped_sine",)
+    allowed = excitations(family)
     if style.excitation not in allowed:
         raise ValueError(f"excitation '{style.excitation}' unknown for {family.model}; allowed: "
                          f"{', '.join(allowed)}")
