@@ -275,6 +275,25 @@ def test_the_summary_tells_misses_the_data_cannot_decide_from_misses_of_the_sear
             "a full run takes at most 96.0 min)") in text
 
 
+def test_a_resumed_or_extended_campaign_states_the_earlier_runs_wall_time():
+    """campaign.wall_of_runs: a run that read cases from an earlier run states that run's wall time beside its own
+    when the earlier run covered the same cases or exactly the ones read (a campaign of 20 cases extended to 40 of
+    the same draw), and its own alone when the earlier summary is of another set of cases."""
+    this = {"wall_s": 600.0, "resumed": 20, "where": "here"}
+    extended = campaign.wall_of_runs(this, 40, {"cases": 20, "wall_s": 2400.0, "resumed": 0, "where": "there"})
+    assert extended == {**this, "earlier_wall_s": 2400.0}
+    # a rerun of 40 whose earlier run (of 40, itself resumed from a run of 20) lost 20 outcomes: both runs before
+    rerun = campaign.wall_of_runs(this, 40, {"cases": 40, "wall_s": 900.0, "earlier_wall_s": 2400.0})
+    assert rerun["earlier_wall_s"] == 3300.0 and rerun["wall_s"] == 600.0
+    # every case read: the earlier run's own statement
+    assert campaign.wall_of_runs({**this, "resumed": 40}, 40, {"cases": 40, "wall_s": 900.0, "resumed": 20,
+                                                                "where": "there", "earlier_wall_s": 2400.0}) == {
+        "wall_s": 900.0, "resumed": 20, "where": "there", "earlier_wall_s": 2400.0}
+    # an earlier summary of 30 cases, 20 of them read now: its wall time is not theirs
+    assert campaign.wall_of_runs(this, 40, {"cases": 30, "wall_s": 2400.0}) == this
+    assert campaign.wall_of_runs(this, 40, None) == this
+
+
 def test_the_truth_s_own_test_is_the_report_s_and_completes_a_stored_outcome(tmp_path):
     """campaign.truth_test: the truth's held-out shrink of the gap against the report's reference (the truth's own
     misfit when lower: the report takes the least of every model's); a stored outcome without it is completed

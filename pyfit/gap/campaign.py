@@ -232,6 +232,20 @@ def run_case(job: CaseJob) -> dict:
     return outcome
 
 
+def wall_of_runs(this_run: dict, n: int, earlier: dict | None) -> dict:
+    """The wall time a campaign of `n` cases states (wall_s, resumed, where, earlier_wall_s), from this run's
+    (`this_run`: its wall time, the cases it read from earlier runs, where it ran) and the summary the run before
+    it wrote (`earlier`, None when there is none or no case was read). Every case read: the earlier run's, as it
+    stated it. Else, when the earlier run covered these n cases (some removed since) or exactly the ones read (a
+    campaign extended to more cases of the same draw), the earlier runs' wall time (earlier_wall_s): with this
+    run's, a full run's at most."""
+    if earlier and this_run["resumed"] == n:
+        return {k: earlier[k] for k in ("wall_s", "resumed", "where", "earlier_wall_s") if k in earlier}
+    if earlier and earlier.get("cases") in (n, this_run["resumed"]):
+        return {**this_run, "earlier_wall_s": earlier["wall_s"] + earlier.get("earlier_wall_s", 0.0)}
+    return this_run
+
+
 def truth_test(gap: dict, truth_held_out: float, cfg: DiagnoseConfig) -> dict:
     """What the report's test for 'explained' would make of the truth at its true parameters, had the search
     found it: its held-out shrink [%] of the gap, against the report's reference (the smaller of the noise floor
@@ -299,15 +313,9 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     else:
         outcomes = map_tasks(run_case, jobs, scheduler=scheduler, progress=progress, desc="campaign")
         where = f"Dask scheduler {scheduler}"
-    run_by = {"wall_s": time.perf_counter() - t0, "resumed": resumed, "where": where}
     before = out / "summary.json"
     earlier = json.loads(before.read_text()) if resumed and before.is_file() else None
-    if earlier and resumed == n:  # every case stored: summarised again, with the wall time of their run
-        run_by = {k: earlier[k] for k in ("wall_s", "resumed", "where", "earlier_wall_s") if k in earlier}
-    elif earlier and earlier.get("cases") == n:
-        # the resumed cases were diagnosed by the run that wrote the summary before (and those it read by the ones
-        # before it): with this run's, a full run's wall time at most
-        run_by["earlier_wall_s"] = earlier["wall_s"] + earlier.get("earlier_wall_s", 0.0)
+    run_by = wall_of_runs({"wall_s": time.perf_counter() - t0, "resumed": resumed, "where": where}, n, earlier)
     if calibrate:
         stated_from = confidence.calibration_of(outcomes, command(n, seed, model, config, excitation, record_s),
                                                 seed, settings, model)
