@@ -93,11 +93,50 @@ def test_rate_within_rounding_is_accepted(tmp_path):
     assert m.sample_rate_hz == pytest.approx(FS, rel=1e-12)
 
 
-def test_semicolon_separator_and_decimal_comma_name_the_fix(tmp_path):
-    with pytest.raises(MeasurementError, match=r"separated by ';'.*'\.' as the decimal mark"):
-        read_measurement(lab_file(tmp_path, sep=";", decimal=","))
-    with pytest.raises(MeasurementError, match=r"row 4: 9 fields but 5 column names \(decimal commas"):
+@pytest.mark.parametrize("sep", [";", "\t"])
+def test_decimal_commas_between_semicolons_or_tabs_read_to_the_same_numbers(tmp_path, sep):
+    """A spreadsheet's export in a locale that writes decimal commas: ';' or a tab between the columns, so a
+    comma in a field can only be the decimal mark. The file is read to the numbers its '.' twin holds."""
+    twin = read_measurement(lab_file(tmp_path, "point", time_fmt="%.10g"))
+    m = read_measurement(lab_file(tmp_path, "comma", sep=sep, decimal=",", time_fmt="%.10g"))
+    for name, v in twin.values.items():
+        np.testing.assert_array_equal(m.values[name], v)
+    np.testing.assert_array_equal(m.t, twin.t)
+
+
+def test_a_units_row_above_decimal_commas_is_skipped(tmp_path):
+    path = lab_file(tmp_path, sep=";", decimal=",", extra=False, time_fmt="%.10g")
+    lines = path.read_text().splitlines()
+    lines.insert(3, "s;mm;kN")  # under the header (two comment lines before it)
+    path.write_text("\n".join(lines) + "\n")
+    m = read_measurement(path)
+    assert np.max(np.abs(m.values["x_mm"] - 2e-3 * np.sin(2 * np.pi * 13 * np.arange(N) / FS))) < 1e-10
+
+
+def test_what_a_decimal_comma_makes_ambiguous_is_refused_naming_the_fix(tmp_path):
+    # decimal commas between ',' separators: a field per digit group, more fields than names
+    with pytest.raises(MeasurementError, match=r"row 4: 9 fields but 5 column names \(decimal commas\? allowed "
+                                               r"with ';' or a tab between columns"):
         read_measurement(lab_file(tmp_path, decimal=",", extra=True, time_fmt="%.6f"))
+    # digit grouping beside a decimal comma (1.234,5): refused, not read as 1.2345 or 1234.5
+    path = lab_file(tmp_path, sep=";", decimal=",", extra=False, time_fmt="%.10g", amp=2000.0)
+    lines = path.read_text().splitlines()
+    t, x, force = lines[5].split(";")
+    lines[5] = ";".join([t, "1.234,5", force])
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(MeasurementError, match=r"not numeric in a used column .*'\.' or ',' as the decimal mark, "
+                                               r"no digit grouping"):
+        read_measurement(path)
+
+
+def test_a_delimiter_inside_a_quoted_name_does_not_choose_the_columns(tmp_path):
+    path = lab_file(tmp_path, sep=";", decimal=",", extra=False, time_fmt="%.10g")
+    text = path.read_text().replace('"x_mm"', '"x, clamp [mm]"')
+    path.write_text(text)
+    side = path.with_suffix(".toml")
+    side.write_text(side.read_text().replace("x_mm = {", '"x, clamp [mm]" = {'))
+    m = read_measurement(path)
+    assert np.max(np.abs(m.values["x, clamp [mm]"] - 2e-3 * np.sin(2 * np.pi * 13 * np.arange(N) / FS))) < 1e-10
 
 
 def test_missing_column_and_unknown_unit(tmp_path):
@@ -184,6 +223,6 @@ def test_units_row_that_contradicts_the_sidecar_is_refused(tmp_path):
 
 def test_space_separated_export_names_the_fix(tmp_path):
     p = _export(tmp_path, "t x F", [r.replace(",", " ") for r in ROWS])
-    with pytest.raises(MeasurementError, match=r"export.csv: row 1: columns are separated by spaces; allowed: ',' "
-                                               r"or a tab"):
+    with pytest.raises(MeasurementError, match=r"export.csv: row 1: columns are separated by spaces; allowed: ',', "
+                                               r"a tab or ';'"):
         read_measurement(p)

@@ -1,5 +1,6 @@
-"""Property-based tests of the measurement reader: a lab file, re-encoded or damaged at random, is either read
-to the same numbers or refused with a MeasurementError that names the file, never another exception."""
+"""Property-based tests of the measurement reader: a lab file, re-encoded (encoding, line ends, column delimiter,
+decimal mark) or damaged at random, is either read to the same numbers or refused with a MeasurementError that
+names the file, never another exception."""
 import codecs
 import pathlib
 
@@ -42,13 +43,20 @@ ENCODINGS = [("utf-8", b""), ("utf-8", codecs.BOM_UTF8), ("utf-16-le", codecs.BO
              ("utf-16-be", codecs.BOM_UTF16_BE), ("utf-32-le", codecs.BOM_UTF32_LE)]
 
 
+# column delimiter and decimal mark as exports write them (a decimal comma only where a comma separates no columns)
+STYLES = [(",", "."), ("\t", "."), (";", ","), ("\t", ","), (";", ".")]
+
+
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(encoding=st.sampled_from(ENCODINGS), newline=st.sampled_from(["\n", "\r\n", "\r"]),
-       trailing=st.sampled_from(["", ",", " "]))
-def test_re_encoded_files_read_to_the_same_numbers(tmp_path, encoding, newline, trailing):
+       trailing=st.sampled_from(["", "delimiter", " "]), style=st.sampled_from(STYLES))
+def test_re_encoded_files_read_to_the_same_numbers(tmp_path, encoding, newline, trailing, style):
     name, bom = encoding
-    lines = lab_text().splitlines()
-    text = newline.join(line + (trailing if k > 0 else "") for k, line in enumerate(lines)) + newline
+    sep, decimal = style
+    lines = [line if line.startswith("#") else sep.join(f.replace(".", decimal) for f in line.split(","))
+             for line in lab_text().splitlines()]
+    end = sep if trailing == "delimiter" else trailing
+    text = newline.join(line + (end if k > 0 else "") for k, line in enumerate(lines)) + newline
     m = read_measurement(write_pair(tmp_path, bom + text.encode(name)))
     for column, values in expected().items():
         # 8 decimals written: the rounding is at most 5e-9 of the written unit

@@ -5,7 +5,10 @@ optional level, level_value, excitation, notes, time_column (default "t"), time_
 
 The reader takes files as lab software writes them, wherever that is still unambiguous:
 - `#` comment lines before the header, quoted column names (commas inside quotes included) and quoted
-  numbers, ',' or tab between columns, a trailing delimiter, extra columns (never parsed);
+  numbers, ',', tab or ';' between columns (the one the header holds most of outside quotes), a trailing
+  delimiter, extra columns (never parsed);
+- decimal commas where the columns are separated by ';' or a tab (a spreadsheet's export in a locale that writes
+  them): a comma inside a field can then only be the decimal mark;
 - a units row under the header (every field non-numeric, e.g. `s,mm,kN`): skipped; where it names a known
   unit for a used column or the time column, that unit must be the sidecar's;
 - unit spellings: `[mm]`, `m/s^2`, `m/s²`, `µm`, `μm` are the same as mm, m/s2, um;
@@ -16,15 +19,16 @@ The reader takes files as lab software writes them, wherever that is still unamb
   electronic oscillator's node voltage), which a model whose every parameter is fitted takes up
   (check_quantities says where it may stand).
 and refuses, with one error naming file, row and value, what is not: a gap, a repeated or decreasing
-time, a time column that disagrees with sample_rate_hz by more than MAX_TIME_SLIP samples, `;`
-separators or decimal commas, columns separated by spaces, a units row that contradicts the sidecar,
-non-numeric or non-finite values in a used column.
+time, a time column that disagrees with sample_rate_hz by more than MAX_TIME_SLIP samples, decimal commas
+between ',' separators, a number with both a '.' and a decimal comma (digit grouping), columns separated by
+spaces, a units row that contradicts the sidecar, non-numeric or non-finite values in a used column.
 """
 from __future__ import annotations
 
 import csv
 import io
 import pathlib
+import re
 import warnings
 from dataclasses import dataclass, field
 
@@ -121,12 +125,28 @@ def _fields(line: str, delimiter: str) -> list[str]:
     return fields[:-1] if len(fields) > 1 and fields[-1] == "" else fields
 
 
-def _numeric(field: str) -> bool:
+def _numeric(field: str, delimiter: str = ",") -> bool:
     try:
-        float(field)
+        float(_decimal_point(field, delimiter))
         return True
     except ValueError:
         return False
+
+
+def _decimal_point(text: str, delimiter: str) -> str:
+    """`text` with its decimal commas as points, where the columns are not separated by commas (';' or a tab:
+    a comma can then only be a decimal mark); as it is where they are."""
+    return text if delimiter == "," else text.replace(",", ".")
+
+
+DELIMITERS = (",", "\t", ";")  # between columns; of as many in a header, the first
+
+
+def _delimiter(header: str) -> str:
+    """The column delimiter of a header line: of DELIMITERS, the one it holds most of outside quoted names
+    (',' when it holds none: a single column)."""
+    bare = re.sub(r'"[^"]*"', "", header)
+    return max(DELIMITERS, key=lambda d: (bare.count(d), -DELIMITERS.index(d)))
 
 
 @dataclass
@@ -159,23 +179,20 @@ def _header(csv_path: pathlib.Path, text: str) -> _Header:
                 rest.append((number, ln))
                 if len(rest) == 2:
                     break
-    delimiter = "," if "," in line or "\t" not in line else "\t"
-    if ";" in line and delimiter not in line:
-        raise MeasurementError(f"{csv_path}: row {skip}: columns are separated by ';' (a decimal-comma export); "
-                               "allowed: ',' between columns and '.' as the decimal mark (export as CSV with a "
-                               "point decimal separator)")
+    delimiter = _delimiter(line)
     names = _fields(line, delimiter)
     first = rest[0][1] if rest else ""
     if len(names) == 1 and len(first.split()) > 1 and delimiter not in first:
-        raise MeasurementError(f"{csv_path}: row {skip}: columns are separated by spaces; allowed: ',' or a tab "
-                               "between columns (export as CSV)")
+        raise MeasurementError(f"{csv_path}: row {skip}: columns are separated by spaces; allowed: ',', a tab or "
+                               "';' between columns (export as CSV)")
     units = {}
-    if first.strip() and not any(_numeric(v) for v in _fields(first, delimiter)):
+    if first.strip() and not any(_numeric(v, delimiter) for v in _fields(first, delimiter)):
         units = dict(zip(names, _fields(first, delimiter)))  # a units row under the header
         skip, first = rest[0][0], rest[1][1] if len(rest) > 1 else ""
     fields = len(_fields(first, delimiter)) if first.strip() else len(names)
     if fields != len(names):
-        hint = " (decimal commas? use '.' as the decimal mark)" if fields > len(names) else ""
+        hint = (" (decimal commas? allowed with ';' or a tab between columns, or '.' as the decimal mark)"
+                if fields > len(names) else "")
         raise MeasurementError(f"{csv_path}: row {skip + 1}: {fields} fields but {len(names)} column names{hint}")
     return _Header(names, skip, delimiter, units)
 
@@ -185,18 +202,20 @@ def _load_columns(csv_path, text: str, head: _Header, wanted: list[str]) -> dict
     try:
         with warnings.catch_warnings():  # an empty body is refused below, with the file named
             warnings.simplefilter("ignore", UserWarning)
-            data = np.loadtxt(_lines(text), delimiter=head.delimiter, skiprows=head.skip, usecols=idx, ndmin=2,
-                              comments="#", quotechar='"')
+            data = np.loadtxt(_lines(_decimal_point(text, head.delimiter)), delimiter=head.delimiter,
+                              skiprows=head.skip, usecols=idx, ndmin=2, comments="#", quotechar='"')
     except ValueError as exc:
+        mark = ("'.' as the decimal mark" if head.delimiter == ","
+                else "'.' or ',' as the decimal mark, no digit grouping")
         raise MeasurementError(f"{csv_path}: not numeric in a used column ({', '.join(wanted)}): {exc}; "
-                               "allowed: numbers with '.' as the decimal mark") from exc
+                               f"allowed: numbers with {mark}") from exc
     if data.shape[0] == 0:
         raise MeasurementError(f"{csv_path}: no data rows after row {head.skip}; allowed: at least two samples")
     return dict(zip(wanted, data.T))
 
 
 def read_csv_columns(csv_path, wanted: list[str]) -> dict[str, np.ndarray]:
-    """The named columns of a lab-style CSV (comment lines, ',' or tab, extra columns), as floats."""
+    """The named columns of a lab-style CSV (comment lines, ',', tab or ';', extra columns), as floats."""
     csv_path = pathlib.Path(csv_path)
     text = read_text(csv_path, MeasurementError)
     head = _header(csv_path, text)
