@@ -116,7 +116,7 @@ def test_a_units_row_above_decimal_commas_is_skipped(tmp_path):
 def test_what_a_decimal_comma_makes_ambiguous_is_refused_naming_the_fix(tmp_path):
     # decimal commas between ',' separators: a field per digit group, more fields than names
     with pytest.raises(MeasurementError, match=r"row 4: 9 fields but 5 column names \(decimal commas\? allowed "
-                                               r"with ';' or a tab between columns"):
+                                               r"with ';', a tab or spaces between columns"):
         read_measurement(lab_file(tmp_path, decimal=",", extra=True, time_fmt="%.6f"))
     # digit grouping beside a decimal comma (1.234,5): refused, not read as 1.2345 or 1234.5
     path = lab_file(tmp_path, sep=";", decimal=",", extra=False, time_fmt="%.10g", amp=2000.0)
@@ -221,8 +221,23 @@ def test_units_row_that_contradicts_the_sidecar_is_refused(tmp_path):
         read_measurement(p)
 
 
-def test_space_separated_export_names_the_fix(tmp_path):
-    p = _export(tmp_path, "t x F", [r.replace(",", " ") for r in ROWS])
-    with pytest.raises(MeasurementError, match=r"export.csv: row 1: columns are separated by spaces; allowed: ',', "
-                                               r"a tab or ';'"):
+@pytest.mark.parametrize("header, rows", [
+    ("Time x F", [r.replace(",", " ") for r in ROWS]),  # one space
+    ("  Time      x          F", ["  " + "  ".join(f"{v:>10}" for v in r.split(",")) for r in ROWS]),  # aligned
+    ('"Time"  "x"  "F"\n s  mm  kN', [r.replace(",", "   ").replace(".", ",") for r in ROWS]),  # decimal commas
+])
+def test_columns_aligned_by_spaces_are_read(tmp_path, header, rows):
+    p = _export(tmp_path, header, rows)
+    side = p.with_suffix(".toml")
+    side.write_text(side.read_text().replace('time_column = "Time, s"', 'time_column = "Time"'))
+    m = read_measurement(p)
+    k = np.arange(400)
+    assert np.array_equal(m.values["x"], 0.5e-3 * k) and np.array_equal(m.values["F"], -2.0e3 * k)
+
+
+def test_names_and_fields_split_at_spaces_into_other_numbers_are_refused(tmp_path):
+    # a name that holds a space, unquoted: four names over three fields
+    p = _export(tmp_path, "Time s x F", [r.replace(",", " ") for r in ROWS])
+    with pytest.raises(MeasurementError, match=r"export.csv: row 2: 3 fields separated by spaces under 4 name\(s\) "
+                                               r"in row 1; allowed: as many names as fields"):
         read_measurement(p)

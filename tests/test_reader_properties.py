@@ -43,8 +43,9 @@ ENCODINGS = [("utf-8", b""), ("utf-8", codecs.BOM_UTF8), ("utf-16-le", codecs.BO
              ("utf-16-be", codecs.BOM_UTF16_BE), ("utf-32-le", codecs.BOM_UTF32_LE)]
 
 
-# column delimiter and decimal mark as exports write them (a decimal comma only where a comma separates no columns)
-STYLES = [(",", "."), ("\t", "."), (";", ","), ("\t", ","), (";", ".")]
+# column delimiter and decimal mark as exports write them (a decimal comma only where a comma separates no columns;
+# columns aligned by one space or several)
+STYLES = [(",", "."), ("\t", "."), (";", ","), ("\t", ","), (";", "."), (" ", "."), ("   ", ",")]
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])

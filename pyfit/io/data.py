@@ -5,10 +5,11 @@ optional level, level_value, excitation, notes, time_column (default "t"), time_
 
 The reader takes files as lab software writes them, wherever that is still unambiguous:
 - `#` comment lines before the header, quoted column names (commas inside quotes included) and quoted
-  numbers, ',', tab or ';' between columns (the one the header holds most of outside quotes), a trailing
+  numbers, ',', tab or ';' between columns (the one the header holds most of outside quotes), or columns
+  aligned by spaces (a header and a row below it that split at spaces into as many fields), a trailing
   delimiter, extra columns (never parsed);
-- decimal commas where the columns are separated by ';' or a tab (a spreadsheet's export in a locale that writes
-  them): a comma inside a field can then only be the decimal mark;
+- decimal commas where the columns are separated by ';', a tab or spaces (a spreadsheet's export in a locale that
+  writes them): a comma inside a field can then only be the decimal mark;
 - a units row under the header (every field non-numeric, e.g. `s,mm,kN`): skipped; where it names a known
   unit for a used column or the time column, that unit must be the sidecar's;
 - unit spellings: `[mm]`, `m/s^2`, `m/s²`, `µm`, `μm` are the same as mm, m/s2, um;
@@ -20,8 +21,9 @@ The reader takes files as lab software writes them, wherever that is still unamb
   (check_quantities says where it may stand).
 and refuses, with one error naming file, row and value, what is not: a gap, a repeated or decreasing
 time, a time column that disagrees with sample_rate_hz by more than MAX_TIME_SLIP samples, decimal commas
-between ',' separators, a number with both a '.' and a decimal comma (digit grouping), columns separated by
-spaces, a units row that contradicts the sidecar, non-numeric or non-finite values in a used column.
+between ',' separators, a number with both a '.' and a decimal comma (digit grouping), a header and rows
+that split at spaces into different numbers of fields, a units row that contradicts the sidecar, non-numeric
+or non-finite values in a used column.
 """
 from __future__ import annotations
 
@@ -119,8 +121,8 @@ def _channels(side, table, section) -> dict[str, Channel]:
 
 
 def _fields(line: str, delimiter: str) -> list[str]:
-    """The fields of one CSV line (quotes removed, a comma inside quotes kept), stripped; a trailing empty
-    field (a line that ends in the delimiter) dropped."""
+    """The fields of one CSV line (quotes removed, a delimiter inside quotes kept), stripped; a trailing empty
+    field (a line that ends in the delimiter) dropped; with SPACES, any run of spaces one delimiter."""
     fields = [f.strip() for f in next(csv.reader([line.strip()], delimiter=delimiter, skipinitialspace=True))]
     return fields[:-1] if len(fields) > 1 and fields[-1] == "" else fields
 
@@ -140,12 +142,16 @@ def _decimal_point(text: str, delimiter: str) -> str:
 
 
 DELIMITERS = (",", "\t", ";")  # between columns; of as many in a header, the first
+SPACES = " "  # columns aligned by spaces (a text export): any run of spaces between fields
 
 
-def _delimiter(header: str) -> str:
-    """The column delimiter of a header line: of DELIMITERS, the one it holds most of outside quoted names
-    (',' when it holds none: a single column)."""
+def _delimiter(header: str, below: str) -> str:
+    """The column delimiter of a header line: of DELIMITERS, the one it holds most of outside quoted names;
+    when it holds none, SPACES if it and the line below it (`below`: a units row or the first data row) split
+    at spaces into as many fields, more than one; else ',' (a single column, whose name may hold spaces)."""
     bare = re.sub(r'"[^"]*"', "", header)
+    if not any(d in bare for d in DELIMITERS) and len(_fields(header, SPACES)) == len(_fields(below, SPACES)) > 1:
+        return SPACES
     return max(DELIMITERS, key=lambda d: (bare.count(d), -DELIMITERS.index(d)))
 
 
@@ -179,19 +185,20 @@ def _header(csv_path: pathlib.Path, text: str) -> _Header:
                 rest.append((number, ln))
                 if len(rest) == 2:
                     break
-    delimiter = _delimiter(line)
-    names = _fields(line, delimiter)
     first = rest[0][1] if rest else ""
+    delimiter = _delimiter(line, first)
+    names = _fields(line, delimiter)
     if len(names) == 1 and len(first.split()) > 1 and delimiter not in first:
-        raise MeasurementError(f"{csv_path}: row {skip}: columns are separated by spaces; allowed: ',', a tab or "
-                               "';' between columns (export as CSV)")
+        raise MeasurementError(f"{csv_path}: row {skip + 1}: {len(first.split())} fields separated by spaces under "
+                               f"{len(_fields(line, SPACES))} name(s) in row {skip}; allowed: as many names as fields, "
+                               "separated by ',', a tab, ';' or spaces (a name that holds a space quoted)")
     units = {}
     if first.strip() and not any(_numeric(v, delimiter) for v in _fields(first, delimiter)):
         units = dict(zip(names, _fields(first, delimiter)))  # a units row under the header
         skip, first = rest[0][0], rest[1][1] if len(rest) > 1 else ""
     fields = len(_fields(first, delimiter)) if first.strip() else len(names)
     if fields != len(names):
-        hint = (" (decimal commas? allowed with ';' or a tab between columns, or '.' as the decimal mark)"
+        hint = (" (decimal commas? allowed with ';', a tab or spaces between columns, or '.' as the decimal mark)"
                 if fields > len(names) else "")
         raise MeasurementError(f"{csv_path}: row {skip + 1}: {fields} fields but {len(names)} column names{hint}")
     return _Header(names, skip, delimiter, units)
@@ -202,7 +209,8 @@ def _load_columns(csv_path, text: str, head: _Header, wanted: list[str]) -> dict
     try:
         with warnings.catch_warnings():  # an empty body is refused below, with the file named
             warnings.simplefilter("ignore", UserWarning)
-            data = np.loadtxt(_lines(_decimal_point(text, head.delimiter)), delimiter=head.delimiter,
+            data = np.loadtxt(_lines(_decimal_point(text, head.delimiter)),
+                              delimiter=None if head.delimiter == SPACES else head.delimiter,
                               skiprows=head.skip, usecols=idx, ndmin=2, comments="#", quotechar='"')
     except ValueError as exc:
         mark = ("'.' as the decimal mark" if head.delimiter == ","
