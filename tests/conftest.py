@@ -115,14 +115,12 @@ def _table(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
-# the test files that run longest (a diagnosis or a fit each, 10-65 s with both workers busy:
-# `pytest --durations=0`, summed per file), longest first: collected first, so that the workers, which take files
-# in the order collected, do not end on one of them alone
-LONGEST_FILES = ("test_gap_stuck_joint.py", "test_gap_loop_friction.py", "test_fitting.py", "test_build.py",
-                 "test_gap.py", "test_gap_nulls.py", "test_damper_far_nominal.py", "test_analysis_rate.py",
-                 "test_reference.py", "test_datasets.py", "test_records.py", "test_impedance_fit.py",
-                 "test_sizing.py", "test_unsettled.py", "test_voltage_channels.py", "test_benchmark_fit.py",
-                 "test_design_check.py", "test_spline_drive.py", "test_gap_band.py")
+# the test files that run longest (a diagnosis or a fit each, 25-90 s on 2 cores), longest first: collected first,
+# so that the workers, which take files in the order collected, do not end on one of them alone
+LONGEST_FILES = ("test_gap_loop_friction.py", "test_gap.py", "test_gap_nulls.py", "test_fitting.py",
+                 "test_damper_far_nominal.py", "test_records.py", "test_reference.py", "test_design_check.py",
+                 "test_unsettled.py", "test_benchmark_fit.py", "test_impedance_fit.py", "test_datasets.py",
+                 "test_strength_grid.py")
 
 
 def pytest_collection_modifyitems(session, config, items):

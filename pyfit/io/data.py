@@ -136,8 +136,8 @@ def _numeric(field: str, delimiter: str = ",") -> bool:
 
 
 def _decimal_point(text: str, delimiter: str) -> str:
-    """`text` with its decimal commas as points, where the columns are not separated by commas (';' or a tab:
-    a comma can then only be a decimal mark); as it is where they are."""
+    """`text` with its decimal commas as points, where the columns are not separated by commas (';', a tab or
+    spaces: a comma can then only be a decimal mark); as it is where they are."""
     return text if delimiter == "," else text.replace(",", ".")
 
 
