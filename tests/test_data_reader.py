@@ -241,3 +241,44 @@ def test_names_and_fields_split_at_spaces_into_other_numbers_are_refused(tmp_pat
     with pytest.raises(MeasurementError, match=r"export.csv: row 2: 3 fields separated by spaces under 4 name\(s\) "
                                                r"in row 1; allowed: as many names as fields"):
         read_measurement(p)
+
+
+def _headerless(tmp_path, rows: list[str], columns='["Time", "x", "F"]', comments=()) -> pathlib.Path:
+    """A numeric export without a header line, its sidecar naming the columns."""
+    path = _export(tmp_path, "", rows)
+    path.write_text("\n".join(list(comments) + rows) + "\n")
+    side = path.with_suffix(".toml")
+    side.write_text(side.read_text().replace('time_column = "Time, s"', f'time_column = "Time"\ncolumns = {columns}'))
+    return path
+
+
+@pytest.mark.parametrize("rows", [
+    ROWS,  # ','
+    [" ".join(f"{float(v):15.7e}" for v in r.split(",")) for r in ROWS],  # MATLAB's save -ascii
+    [r.replace(",", ";").replace(".", ",") for r in ROWS],  # ';' and decimal commas
+    [r.replace(",", "\t") for r in ROWS],  # tab
+])
+def test_a_file_without_a_header_line_is_read_with_the_sidecar_s_column_names(tmp_path, rows):
+    m = read_measurement(_headerless(tmp_path, rows, comments=("# logger dump",)))
+    k = np.arange(400)
+    np.testing.assert_allclose(m.values["x"], 0.5e-3 * k, rtol=1e-7, atol=0)  # 8 significant digits written
+    np.testing.assert_allclose(m.values["F"], -2.0e3 * k, rtol=1e-7, atol=0)
+    assert np.max(np.abs(m.t - k / FS)) < 1e-8
+
+
+def test_a_header_line_and_its_absence_are_told_apart_by_name(tmp_path):
+    # numbers where the names should be: the sidecar's `columns` named as the fix
+    path = _export(tmp_path, ROWS[0], ROWS[1:])
+    with pytest.raises(MeasurementError, match=r"export.csv: row 1 holds numbers, not column names; allowed: a "
+                                               r"header line of column names above the data, or the sidecar's "
+                                               r"`columns = \[...\]`"):
+        read_measurement(path)
+    # a header line under a sidecar that names the columns: the row and the fix named
+    path = _headerless(tmp_path, ['"Time, s",x,F'] + ROWS)
+    with pytest.raises(MeasurementError, match=r"row 1 does not split into 3 numbers \(the sidecar's columns: Time, "
+                                               r"x, F\).*\(a file with a header line: no `columns` in the sidecar\)"):
+        read_measurement(path)
+    # a name twice, or none
+    for columns in ('["Time", "x", "x"]', "[]"):
+        with pytest.raises(MeasurementError, match=r"export.toml: \[columns\] .* names no column or one twice"):
+            read_measurement(_headerless(tmp_path, ROWS, columns=columns))

@@ -1,9 +1,12 @@
 """Measurement files (theory §5): a CSV plus a TOML sidecar of the same stem.
 
 Sidecar keys: model, sample_rate_hz, [inputs] and [outputs] mapping column -> {unit, model_variable[, weight]};
-optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s" or "ms").
+optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s" or "ms"), columns (the
+names of the columns of a file without a header line, in order).
 
 The reader takes files as lab software writes them, wherever that is still unambiguous:
+- files without a header line (a numeric export: MATLAB's `save -ascii`, a logger's raw dump) whose sidecar
+  names their columns (`columns = [...]`);
 - `#` comment lines before the header, quoted column names (commas inside quotes included) and quoted
   numbers, ',', tab or ';' between columns (the one the header holds most of outside quotes), or columns
   aligned by spaces (a header and a row below it that split at spaces into as many fields), a trailing
@@ -50,7 +53,7 @@ MAX_TIME_SLIP = 0.25  # largest allowed distance [samples] of a time stamp from 
 SIDECAR = {"model": (str, True, None), "sample_rate_hz": ("number", True, None), "inputs": (dict, False, {}),
            "outputs": (dict, True, None), "level": (str, False, ""), "level_value": ("number", False, None),
            "excitation": (dict, False, {}), "notes": (str, False, ""), "time_column": (str, False, "t"),
-           "time_unit": (str, False, "s")}
+           "time_unit": (str, False, "s"), "columns": ("strings", False, None)}
 
 
 def unit_key(unit: str) -> str:
@@ -171,14 +174,15 @@ def _lines(text: str) -> io.StringIO:
     return io.StringIO(text, newline=None)
 
 
-def _header(csv_path: pathlib.Path, text: str) -> _Header:
-    """Read the lines before the data: '#' comments, the header, and a units row if there is one."""
+def _header(csv_path: pathlib.Path, text: str, columns: list[str] | None = None) -> _Header:
+    """Read the lines before the data: '#' comments, the header, and a units row if there is one; with
+    `columns` (the sidecar's names of a file without a header line), the comments only."""
     with _lines(text) as f:
         for skip, line in enumerate(f, 1):
             if line.strip() and not line.lstrip().startswith("#"):
                 break
         else:
-            raise MeasurementError(f"{csv_path}: no header line (only comments or empty)")
+            raise MeasurementError(f"{csv_path}: no {'data' if columns else 'header'} line (only comments or empty)")
         rest = []  # the next two lines with content, and their line numbers
         for number, ln in enumerate(f, skip + 1):
             if ln.strip() and not ln.lstrip().startswith("#"):
@@ -186,8 +190,14 @@ def _header(csv_path: pathlib.Path, text: str) -> _Header:
                 if len(rest) == 2:
                     break
     first = rest[0][1] if rest else ""
+    if columns:
+        return _unnamed(csv_path, line, skip, columns)
     delimiter = _delimiter(line, first)
     names = _fields(line, delimiter)
+    if all(_numeric(v, delimiter) for v in names):
+        raise MeasurementError(f"{csv_path}: row {skip} holds numbers, not column names; allowed: a header line of "
+                               "column names above the data, or the sidecar's `columns = [...]` naming the columns "
+                               "of a file without one")
     if len(names) == 1 and len(first.split()) > 1 and delimiter not in first:
         raise MeasurementError(f"{csv_path}: row {skip + 1}: {len(first.split())} fields separated by spaces under "
                                f"{len(_fields(line, SPACES))} name(s) in row {skip}; allowed: as many names as fields, "
@@ -202,6 +212,19 @@ def _header(csv_path: pathlib.Path, text: str) -> _Header:
                 if fields > len(names) else "")
         raise MeasurementError(f"{csv_path}: row {skip + 1}: {fields} fields but {len(names)} column names{hint}")
     return _Header(names, skip, delimiter, units)
+
+
+def _unnamed(csv_path: pathlib.Path, line: str, row: int, columns: list[str]) -> _Header:
+    """The header of a file without a header line whose first data line is `line` (row `row`): the sidecar's
+    `columns`, and the delimiter that splits that line into as many numbers (',', a tab, ';', spaces: the
+    first that does)."""
+    for delimiter in DELIMITERS + (SPACES,):
+        fields = _fields(line, delimiter)
+        if len(fields) == len(columns) and all(_numeric(v, delimiter) for v in fields):
+            return _Header(list(columns), row - 1, delimiter, {})
+    raise MeasurementError(f"{csv_path}: row {row} does not split into {len(columns)} numbers (the sidecar's "
+                           f"columns: {', '.join(columns)}); allowed: one number per named column, separated by ',', "
+                           "a tab, ';' or spaces (a file with a header line: no `columns` in the sidecar)")
 
 
 def _load_columns(csv_path, text: str, head: _Header, wanted: list[str]) -> dict[str, np.ndarray]:
@@ -270,6 +293,10 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
     if not csv_path.is_file():
         raise MeasurementError(f"{csv_path}: file not found")
     meta = check_table(read_toml(side, MeasurementError), side, "", SIDECAR, MeasurementError)
+    columns = meta["columns"]
+    if columns is not None and (not columns or len(set(columns)) < len(columns)):
+        fail(side, "columns", f"{columns} names no column or one twice", "the names of the file's columns, each "
+             "once, in order", MeasurementError)
     fs = meta["sample_rate_hz"]
     if not fs > 0:
         fail(side, "sample_rate_hz", f"{fs} is not > 0", error=MeasurementError)
@@ -278,7 +305,7 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
     inputs = _channels(side, meta["inputs"], "inputs")
     outputs = _channels(side, meta["outputs"], "outputs")
     text = read_text(csv_path, MeasurementError)
-    head = _header(csv_path, text)
+    head = _header(csv_path, text, meta["columns"])
     names, skip = head.names, head.skip
     for name, ch in {**inputs, **outputs}.items():
         if name not in names:
