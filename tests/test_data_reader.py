@@ -146,7 +146,7 @@ def test_missing_column_and_unknown_unit(tmp_path):
     with pytest.raises(MeasurementError, match=r"run.csv: column 'x_um' named in run.toml is missing; columns: t, x_mm"):
         read_measurement(p)
     side.write_text(side.read_text().replace('x_um = { unit = "mm"', 'x_mm = { unit = "inch"'))
-    with pytest.raises(MeasurementError, match=r"run.toml: \[outputs.x_mm.unit\] 'inch' unknown; allowed: m, mm"):
+    with pytest.raises(MeasurementError, match=r"run.toml: \[outputs.x_mm.unit\] 'inch' unknown; allowed: m, cm, mm"):
         read_measurement(p)
 
 
@@ -206,6 +206,15 @@ def test_lab_export_variants_are_read(tmp_path, header, rows, unit_x):
 @pytest.mark.parametrize("unit, si", [("m/s^2", 1.0), ("m/s²", 1.0), ("mm/s^2", 1e-3), ("µm", 1e-6), ("μm", 1e-6),
                                       ("[m/s]", 1.0)])
 def test_unit_spellings(tmp_path, unit, si):
+    m = read_measurement(_export(tmp_path, '"Time, s",x,F', ROWS, unit))
+    assert m.values["x"][2] == pytest.approx(1.0 * si, rel=1e-15)
+
+
+# the definitions, written out: 1 in = 2.54 cm, 1 ft = 12 in, 1 lbf = 1 lb (0.45359237 kg) x standard gravity
+@pytest.mark.parametrize("unit, si", [("cm", 0.01), ("in", 0.0254), ("ft", 12 * 0.0254), ("in/s", 0.0254),
+                                      ("ft/s^2", 12 * 0.0254), ("cm/s²", 0.01), ("mg", 9.80665e-3), ("mN", 1e-3),
+                                      ("daN", 10.0), ("lbf", 0.45359237 * 9.80665)])
+def test_lab_and_imperial_units_convert_to_si(tmp_path, unit, si):
     m = read_measurement(_export(tmp_path, '"Time, s",x,F', ROWS, unit))
     assert m.values["x"][2] == pytest.approx(1.0 * si, rel=1e-15)
 

@@ -188,7 +188,7 @@ def test_a_fit_target_channel_in_another_quantity_is_refused(tmp_path, fmu_dir):
         with pytest.raises(MeasurementError) as err:
             open_objectives(cfg, fmu_dir)
         assert f"[outputs.y_meas.unit] '{unit}' measures {quantity}; model_variable 'y' is length (m)" in str(
-            err.value) and "allowed: m, mm, um" in str(err.value), str(err.value)
+            err.value) and "allowed: m, cm, mm, um, in, ft" in str(err.value), str(err.value)
 
 
 def test_fit_batch_writes_results_and_resumes_without_redoing(tmp_path, fmu_dir):

@@ -41,11 +41,16 @@ import numpy as np
 
 from pyfit.io.schema import ConfigError, check_table, fail, read_text, read_toml
 
-TO_SI = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "rad": 1.0, "deg": np.pi / 180, "m/s": 1.0, "mm/s": 1e-3,
-         "m/s2": 1.0, "mm/s2": 1e-3, "g": 9.80665, "N": 1.0, "kN": 1e3, "V": 1.0, "mV": 1e-3}
-QUANTITY = {"m": "length", "mm": "length", "um": "length", "rad": "angle", "deg": "angle", "m/s": "velocity",
-            "mm/s": "velocity", "m/s2": "acceleration", "mm/s2": "acceleration", "g": "acceleration",
-            "N": "force", "kN": "force", "V": "voltage", "mV": "voltage"}  # of each unit of TO_SI
+G0 = 9.80665  # standard gravity [m/s2], exact by definition
+INCH, FOOT, POUND = 0.0254, 0.3048, 0.45359237  # [m], [m], [kg]: exact by the 1959 international agreement
+TO_SI = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": INCH, "ft": FOOT, "rad": 1.0, "deg": np.pi / 180,
+         "m/s": 1.0, "cm/s": 1e-2, "mm/s": 1e-3, "in/s": INCH, "ft/s": FOOT,
+         "m/s2": 1.0, "cm/s2": 1e-2, "mm/s2": 1e-3, "in/s2": INCH, "ft/s2": FOOT, "g": G0, "mg": 1e-3 * G0,
+         "N": 1.0, "mN": 1e-3, "daN": 10.0, "kN": 1e3, "lbf": POUND * G0, "V": 1.0, "mV": 1e-3}
+QUANTITY = {**{u: "length" for u in ("m", "cm", "mm", "um", "in", "ft")}, "rad": "angle", "deg": "angle",
+            **{u: "velocity" for u in ("m/s", "cm/s", "mm/s", "in/s", "ft/s")},
+            **{u: "acceleration" for u in ("m/s2", "cm/s2", "mm/s2", "in/s2", "ft/s2", "g", "mg")},
+            **{u: "force" for u in ("N", "mN", "daN", "kN", "lbf")}, "V": "voltage", "mV": "voltage"}  # of TO_SI
 TIME_UNITS = {"s": 1.0, "ms": 1e-3}
 MAX_ABS_SI = 1e100  # largest magnitude of a measured value in SI units: its square over a million samples,
 #                      and its derivatives at MHz rates, stay far inside double precision (1.8e308)
