@@ -4,7 +4,7 @@ import pathlib
 import numpy as np
 import pytest
 
-from pyfit.io.data import MeasurementError, read_dataset_with_order, read_measurement
+from pyfit.io.data import MeasurementError, check_quantities, read_dataset_with_order, read_measurement
 
 FS = 750.0
 N = 26251  # 35 s at 750 Hz: t = 35 s written with 6 significant digits is off by up to 5e-5 s = 0.04 sample
@@ -291,3 +291,43 @@ def test_a_header_line_and_its_absence_are_told_apart_by_name(tmp_path):
     for columns in ('["Time", "x", "x"]', "[]"):
         with pytest.raises(MeasurementError, match=r"export.toml: \[columns\] .* names no column or one twice"):
             read_measurement(_headerless(tmp_path, ROWS, columns=columns))
+
+
+def _with_sensitivity(tmp_path, unit: str, sensitivity: str, variable="y") -> pathlib.Path:
+    """The export's x column recorded as a sensor's voltage in `unit`, with `sensitivity` in the sidecar."""
+    path = _export(tmp_path, '"Time, s",x,F', ROWS)
+    side = path.with_suffix(".toml")
+    side.write_text(side.read_text().replace(
+        'x = { unit = "mm", model_variable = "y" }',
+        f'x = {{ unit = "{unit}", model_variable = "{variable}", sensitivity = "{sensitivity}" }}'))
+    return path
+
+
+# what the column reads, by hand: volts over the sensitivity in its unit, that unit in SI
+@pytest.mark.parametrize("unit, sensitivity, si_per_number, quantity_unit, model_unit", [
+    ("mV", "100 mV/g", 1e-3 / 0.1 * 9.80665, "g", "m/s2"),  # an accelerometer
+    ("V", "2.25 mV/N", 1.0 / 2.25e-3, "N", "N"),  # a force cell
+    ("V", "10 V/mm", 0.1 * 1e-3, "mm", "m"),  # a displacement sensor
+    ("mV", " 1e2  mV / m/s^2 ", 1e-3 / 0.1, "m/s2", "m/s2"),  # spaces, an exponent, a spelling of the unit
+])
+def test_a_voltage_with_its_sensor_s_sensitivity_reads_what_the_sensor_measures(tmp_path, unit, sensitivity,
+                                                                                si_per_number, quantity_unit,
+                                                                                model_unit):
+    m = read_measurement(_with_sensitivity(tmp_path, unit, sensitivity))
+    k = np.arange(400)
+    np.testing.assert_allclose(m.values["x"], 0.5 * k * si_per_number, rtol=1e-14, atol=0)
+    assert m.outputs["x"].quantity_unit == quantity_unit
+    # what it measures is checked against the model variable, not the volts: no voltage channel
+    assert check_quantities(m, {"y": model_unit, "u": "N"}, voltages=False) == []
+
+
+@pytest.mark.parametrize("unit, sensitivity, says", [
+    ("mm", "100 mV/g", r"\[outputs.x.sensitivity\] on a column in 'mm', not a voltage"),
+    ("mV", "100 mV per g", r"\[outputs.x.sensitivity\] '100 mV per g' is not a sensitivity"),
+    ("mV", "100 mV/furlong", r"'100 mV/furlong' is not a sensitivity"),
+    ("mV", "1 V/mV", r"'1 V/mV' is not a sensitivity"),
+    ("mV", "0 mV/g", r"'0 mV/g' is not a sensitivity"),
+])
+def test_a_sensitivity_that_cannot_be_read_is_refused_naming_the_field(tmp_path, unit, sensitivity, says):
+    with pytest.raises(MeasurementError, match=says + r".*allowed: '<number> V/<unit>' or '<number> mV/<unit>'"):
+        read_measurement(_with_sensitivity(tmp_path, unit, sensitivity))

@@ -82,6 +82,6 @@ def test_a_damper_channel_in_volts_is_refused(fmu_dir, tmp_path):
         dg.diagnose("damper", tmp_path / "data", tmp_path / "out", CI, fmu_dir, workers=1, progress=False)
     msg = str(err.value)
     assert "[outputs.acc.unit]" in msg and "'V' measures voltage; model_variable 'acc_x1' is acceleration" in msg
-    assert "convert it with the sensor's sensitivity" in msg, msg
+    assert "give the sensor's sensitivity, e.g. sensitivity = \"100 mV/g\"" in msg, msg
     assert "allowed: m/s2, cm/s2, mm/s2, in/s2, ft/s2, g, mg" in msg, msg
     assert "\n" not in msg

@@ -1,6 +1,7 @@
 """Measurement files (theory §5): a CSV plus a TOML sidecar of the same stem.
 
-Sidecar keys: model, sample_rate_hz, [inputs] and [outputs] mapping column -> {unit, model_variable[, weight]};
+Sidecar keys: model, sample_rate_hz, [inputs] and [outputs] mapping column -> {unit, model_variable[, weight,
+sensitivity]} (sensitivity: a voltage column's sensor, e.g. "100 mV/g": read as what the sensor measures);
 optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s" or "ms"), columns (the
 names of the columns of a file without a header line, in order).
 
@@ -76,12 +77,44 @@ class MeasurementError(ConfigError):
 
 @dataclass
 class Channel:
-    """One measured column: its unit in the file, the model variable it corresponds to, its weight."""
+    """One measured column: its unit in the file, the model variable it corresponds to, its weight, and for a
+    sensor's voltage its sensitivity: `volts_per_unit` volts per one `measures` (e.g. 0.1 V per g)."""
 
     column: str
     unit: str
     model_variable: str
     weight: float = 1.0
+    volts_per_unit: float | None = None
+    measures: str | None = None  # the unit the sensitivity is per (None: the column's own unit)
+
+    @property
+    def quantity_unit(self) -> str:
+        """The unit of what the column measures: the sensitivity's, or the column's own."""
+        return self.measures or self.unit
+
+    @property
+    def to_si(self) -> float:
+        """SI units of the measured quantity per number in the file."""
+        if self.volts_per_unit is None:
+            return TO_SI[self.unit]
+        return TO_SI[self.unit] / self.volts_per_unit * TO_SI[self.measures]
+
+
+SENSITIVITY = re.compile(r"^\s*([0-9.]+(?:[eE][+-]?[0-9]+)?)\s*(V|mV)\s*/\s*(\S+)\s*$")
+
+
+def _sensitivity(side, where: str, text: str, unit: str) -> tuple[float, str]:
+    """A sensor's sensitivity written as '100 mV/g' (a positive number, V or mV, per a unit of TO_SI that is
+    no voltage) on a voltage column: (volts per unit, unit)."""
+    allowed = ("'<number> V/<unit>' or '<number> mV/<unit>', e.g. '100 mV/g', '2.25 mV/N', '10 V/mm', on a V or "
+               "mV column")
+    if QUANTITY[unit] != "voltage":
+        fail(side, where, f"on a column in '{unit}', not a voltage", allowed, MeasurementError)
+    match = SENSITIVITY.match(text) if isinstance(text, str) else None
+    per = unit_key(match.group(3)) if match else ""
+    if not match or per not in TO_SI or QUANTITY[per] == "voltage" or not float(match.group(1)) > 0:
+        fail(side, where, f"{text!r} is not a sensitivity", allowed, MeasurementError)
+    return float(match.group(1)) * TO_SI[match.group(2)], per
 
 
 @dataclass
@@ -118,13 +151,16 @@ def _channels(side, table, section) -> dict[str, Channel]:
     out = {}
     for col, spec in table.items():
         c = check_table(spec, side, f"{section}.{col}", {"unit": (str, True, None), "model_variable": (str, True, None),
-                                                         "weight": ("number", False, 1.0)}, MeasurementError)
+                                                         "weight": ("number", False, 1.0),
+                                                         "sensitivity": (str, False, None)}, MeasurementError)
         c["unit"] = unit_key(c["unit"])
         if c["unit"] not in TO_SI:
             fail(side, f"{section}.{col}.unit", f"'{c['unit']}' unknown", ", ".join(TO_SI), MeasurementError)
         if c["weight"] <= 0:
             fail(side, f"{section}.{col}.weight", f"{c['weight']} is not > 0", error=MeasurementError)
-        out[col] = Channel(col, c["unit"], c["model_variable"], c["weight"])
+        volts, per = (_sensitivity(side, f"{section}.{col}.sensitivity", c["sensitivity"], c["unit"])
+                      if c["sensitivity"] is not None else (None, None))
+        out[col] = Channel(col, c["unit"], c["model_variable"], c["weight"], volts, per)
     return out
 
 
@@ -342,7 +378,7 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
             raise MeasurementError(f"{csv_path}: row {skip + 1 + bad[0]}: column '{name}' is not finite "
                                    f"({bad.size} such value(s)); allowed: finite numbers")
         with np.errstate(over="ignore"):
-            values[name] = v * TO_SI[ch.unit]
+            values[name] = v * ch.to_si
         bad = np.flatnonzero(~(np.abs(values[name]) <= MAX_ABS_SI))
         if bad.size:
             raise MeasurementError(f"{csv_path}: row {skip + 1 + bad[0]}: column '{name}' = {v[bad[0]]:.6g} "
@@ -436,15 +472,15 @@ def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool
     for section, channels in (("inputs", m.inputs), ("outputs", m.outputs)):
         for col, ch in channels.items():
             unit = unit_key(model_units.get(ch.model_variable, ""))
-            want, got = QUANTITY.get(unit), QUANTITY[ch.unit]
+            want, got = QUANTITY.get(unit), QUANTITY[ch.quantity_unit]
             if got == "voltage" and voltages:
                 volts.append(f"{col} ({ch.model_variable})")
             if want is None or got == want or (voltages and got == "voltage"):
                 continue
             allowed = [u for u, q in QUANTITY.items() if q == want or (voltages and q == "voltage")]
-            why = (" (a voltage stands for it only where every model parameter is fitted: convert it with the "
-                   "sensor's sensitivity)" if got == "voltage" else "")
-            fail(side, f"{section}.{col}.unit", f"'{ch.unit}' measures {got}; model_variable "
+            why = (" (a voltage stands for it only where every model parameter is fitted: give the sensor's "
+                   "sensitivity, e.g. sensitivity = \"100 mV/g\")" if got == "voltage" else "")
+            fail(side, f"{section}.{col}.unit", f"'{ch.quantity_unit}' measures {got}; model_variable "
                  f"'{ch.model_variable}' is {want} ({unit}){why}", ", ".join(allowed), MeasurementError)
     return volts
 
