@@ -284,8 +284,13 @@ def test_a_header_line_and_its_absence_are_told_apart_by_name(tmp_path):
         read_measurement(path)
     # a header line under a sidecar that names the columns: the row and the fix named
     path = _headerless(tmp_path, ['"Time, s",x,F'] + ROWS)
+    with pytest.raises(MeasurementError, match=r"row 1 names the columns \(Time, s, x, F\) but the sidecar's "
+                                               r"`columns` names them too \(Time, x, F\); allowed: one of the two"):
+        read_measurement(path)
+    # a line that splits into as many numbers nowhere: the first line named
+    path = _headerless(tmp_path, [r + ",1" for r in ROWS])
     with pytest.raises(MeasurementError, match=r"row 1 does not split into 3 numbers \(the sidecar's columns: Time, "
-                                               r"x, F\).*\(a file with a header line: no `columns` in the sidecar\)"):
+                                               r"x, F\)"):
         read_measurement(path)
     # a name twice, or none
     for columns in ('["Time", "x", "x"]', "[]"):
@@ -331,3 +336,26 @@ def test_a_voltage_with_its_sensor_s_sensitivity_reads_what_the_sensor_measures(
 def test_a_sensitivity_that_cannot_be_read_is_refused_naming_the_field(tmp_path, unit, sensitivity, says):
     with pytest.raises(MeasurementError, match=says + r".*allowed: '<number> V/<unit>' or '<number> mV/<unit>'"):
         read_measurement(_with_sensitivity(tmp_path, unit, sensitivity))
+
+
+PREAMBLE = ["Sample rate: 750 Hz", "Date,2026-05-04", "Operator;X", "Channels: Time, x, F", "", "Test 12 12.5 3"]
+
+
+def test_a_preamble_without_comment_marks_is_skipped_up_to_the_header(tmp_path):
+    """An export's settings above the header, as DAQ software writes them (no '#'): the header is the first line
+    that names every column the sidecar uses; a units row under it and the rows below read as without the
+    preamble."""
+    path = _export(tmp_path, "\n".join(PREAMBLE + ['"Time, s",x,F', "s,mm,kN"]), ROWS)
+    m = read_measurement(path)
+    k = np.arange(400)
+    assert np.array_equal(m.values["x"], 0.5e-3 * k) and np.array_equal(m.values["F"], -2.0e3 * k)
+    # a row named in an error counts the preamble's lines: the units row is row 8
+    path.write_text(path.read_text().replace("s,mm,kN", "s,m,kN"))
+    with pytest.raises(MeasurementError, match=r"export.csv: row 8: the units row gives 'm' for column 'x'"):
+        read_measurement(path)
+
+
+def test_a_preamble_above_a_file_without_a_header_line_is_skipped(tmp_path):
+    path = _headerless(tmp_path, PREAMBLE + [r.replace(",", ";").replace(".", ",") for r in ROWS])
+    m = read_measurement(path)
+    assert np.array_equal(m.values["F"], -2.0e3 * np.arange(400))

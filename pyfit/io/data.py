@@ -8,6 +8,8 @@ names of the columns of a file without a header line, in order).
 The reader takes files as lab software writes them, wherever that is still unambiguous:
 - files without a header line (a numeric export: MATLAB's `save -ascii`, a logger's raw dump) whose sidecar
   names their columns (`columns = [...]`);
+- a preamble before the header without '#' (an export's settings, date, channel list): the header is the
+  first line that names every column the sidecar uses;
 - `#` comment lines before the header, quoted column names (commas inside quotes included) and quoted
   numbers, ',', tab or ';' between columns (the one the header holds most of outside quotes), or columns
   aligned by spaces (a header and a row below it that split at spaces into as many fields), a trailing
@@ -33,6 +35,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import pathlib
 import re
 import warnings
@@ -215,24 +218,46 @@ def _lines(text: str) -> io.StringIO:
     return io.StringIO(text, newline=None)
 
 
-def _header(csv_path: pathlib.Path, text: str, columns: list[str] | None = None) -> _Header:
-    """Read the lines before the data: '#' comments, the header, and a units row if there is one; with
-    `columns` (the sidecar's names of a file without a header line), the comments only."""
+PREAMBLE_LINES = 100  # lines looked through for the header (or a header-less file's first data line)
+
+
+def _content(text: str):
+    """(row number, line) of each line with content that is no '#' comment."""
     with _lines(text) as f:
-        for skip, line in enumerate(f, 1):
+        for number, line in enumerate(f, 1):
             if line.strip() and not line.lstrip().startswith("#"):
-                break
-        else:
-            raise MeasurementError(f"{csv_path}: no {'data' if columns else 'header'} line (only comments or empty)")
-        rest = []  # the next two lines with content, and their line numbers
-        for number, ln in enumerate(f, skip + 1):
-            if ln.strip() and not ln.lstrip().startswith("#"):
-                rest.append((number, ln))
-                if len(rest) == 2:
-                    break
+                yield number, line
+
+
+def _first_row(lines: list[tuple[int, str]], wanted: list[str], columns: list[str] | None) -> int:
+    """Where the header is among `lines` (_content's; a file without a header line: its first data line), past
+    a preamble without '#' (an export's settings, its date, its channel list): the first line that names every
+    `wanted` column in as many fields as the line below it holds, or that splits into as many numbers as
+    `columns` has names; the first line when none does (which is then refused, naming its row)."""
+    for k, (_, line) in enumerate(lines[:PREAMBLE_LINES]):
+        if columns and any(len(f) == len(columns) and all(_numeric(v, d) for v in f)
+                           for d in DELIMITERS + (SPACES,) for f in [_fields(line, d)]):
+            return k
+        below = lines[k + 1][1] if k + 1 < len(lines) else ""
+        delimiter = _delimiter(line, below)
+        names = _fields(line, delimiter)
+        if not columns and wanted and set(wanted) <= set(names) and len(names) == len(_fields(below, delimiter)):
+            return k
+    return 0
+
+
+def _header(csv_path: pathlib.Path, text: str, wanted: list[str] = (), columns: list[str] | None = None) -> _Header:
+    """Read the lines before the data: '#' comments, a preamble (_first_row: where the `wanted` columns are
+    named), the header, and a units row if there is one; with `columns` (the sidecar's names of a file without
+    a header line), the comments and the preamble only."""
+    lines = list(itertools.islice(_content(text), PREAMBLE_LINES + 3))
+    if not lines:
+        raise MeasurementError(f"{csv_path}: no {'data' if columns else 'header'} line (only comments or empty)")
+    k = _first_row(lines, list(wanted), columns)
+    (skip, line), rest = lines[k], lines[k + 1:k + 3]
     first = rest[0][1] if rest else ""
     if columns:
-        return _unnamed(csv_path, line, skip, columns)
+        return _unnamed(csv_path, line, skip, columns, lines[k - 1] if k else None)
     delimiter = _delimiter(line, first)
     names = _fields(line, delimiter)
     if all(_numeric(v, delimiter) for v in names):
@@ -255,13 +280,19 @@ def _header(csv_path: pathlib.Path, text: str, columns: list[str] | None = None)
     return _Header(names, skip, delimiter, units)
 
 
-def _unnamed(csv_path: pathlib.Path, line: str, row: int, columns: list[str]) -> _Header:
+def _unnamed(csv_path: pathlib.Path, line: str, row: int, columns: list[str], above=None) -> _Header:
     """The header of a file without a header line whose first data line is `line` (row `row`): the sidecar's
     `columns`, and the delimiter that splits that line into as many numbers (',', a tab, ';', spaces: the
-    first that does)."""
+    first that does). The line `above` it ((row, line), None when there is none) must not be a header: as many
+    fields, none a number (the columns it names could be in another order than the sidecar's)."""
     for delimiter in DELIMITERS + (SPACES,):
         fields = _fields(line, delimiter)
         if len(fields) == len(columns) and all(_numeric(v, delimiter) for v in fields):
+            names = _fields(above[1], delimiter) if above else []
+            if len(names) == len(columns) and not any(_numeric(v, delimiter) for v in names):
+                raise MeasurementError(f"{csv_path}: row {above[0]} names the columns ({', '.join(names)}) but the "
+                                       f"sidecar's `columns` names them too ({', '.join(columns)}); allowed: one of "
+                                       "the two (a file with a header line: no `columns` in the sidecar)")
             return _Header(list(columns), row - 1, delimiter, {})
     raise MeasurementError(f"{csv_path}: row {row} does not split into {len(columns)} numbers (the sidecar's "
                            f"columns: {', '.join(columns)}); allowed: one number per named column, separated by ',', "
@@ -290,7 +321,7 @@ def read_csv_columns(csv_path, wanted: list[str]) -> dict[str, np.ndarray]:
     """The named columns of a lab-style CSV (comment lines, ',', tab or ';', extra columns), as floats."""
     csv_path = pathlib.Path(csv_path)
     text = read_text(csv_path, MeasurementError)
-    head = _header(csv_path, text)
+    head = _header(csv_path, text, wanted)
     for w in wanted:
         if w not in head.names:
             raise MeasurementError(f"{csv_path}: no column {w!r}; columns: {', '.join(head.names)}")
@@ -346,7 +377,7 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
     inputs = _channels(side, meta["inputs"], "inputs")
     outputs = _channels(side, meta["outputs"], "outputs")
     text = read_text(csv_path, MeasurementError)
-    head = _header(csv_path, text, meta["columns"])
+    head = _header(csv_path, text, list({**inputs, **outputs}), meta["columns"])
     names, skip = head.names, head.skip
     for name, ch in {**inputs, **outputs}.items():
         if name not in names:
