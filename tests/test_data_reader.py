@@ -359,3 +359,14 @@ def test_a_preamble_above_a_file_without_a_header_line_is_skipped(tmp_path):
     path = _headerless(tmp_path, PREAMBLE + [r.replace(",", ";").replace(".", ",") for r in ROWS])
     m = read_measurement(path)
     assert np.array_equal(m.values["F"], -2.0e3 * np.arange(400))
+
+
+def test_an_inverted_sensor_is_read_in_the_model_s_sign_convention(tmp_path):
+    path = _with_sensitivity(tmp_path, "mV", "100 mV/g")
+    plain = read_measurement(path).values["x"]
+    side = path.with_suffix(".toml")
+    side.write_text(side.read_text().replace('sensitivity = "100 mV/g"', 'sensitivity = "100 mV/g", invert = true'))
+    assert np.array_equal(read_measurement(path).values["x"], -plain)
+    side.write_text(side.read_text().replace("invert = true", 'invert = "yes"'))
+    with pytest.raises(MeasurementError, match=r"\[outputs.x.invert\] must be bool, not 'yes'"):
+        read_measurement(path)

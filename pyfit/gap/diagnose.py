@@ -21,7 +21,7 @@ from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
 from pyfit.runtime.examples import ensure_fmu
 from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read_toml
-from pyfit.gap import band, confidence, localise, selection, user_candidates
+from pyfit.gap import band, confidence, localise, polarity, selection, user_candidates
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, nominal_task, pinned, run_fit, screen
 from pyfit.gap.rate import AnalysisRate, analysis_rate, at_rate, drive_upsample
@@ -711,6 +711,27 @@ def _detection(system, fits: dict, sims: dict, held, gap: dict, scale, runner, c
             "detected": not effect.linear and selection.detected_by_refit(before, after[best], cfg.min_detect_cut)}
 
 
+def _check_signs(system, fmu: str, cal: list, cfg: DiagnoseConfig, nominal: Fit, best: float, data_dir,
+                 workers) -> None:
+    """Where the calibrated nominal fits no calibration file (`best`: its NRMSE on the one it fits best), whether
+    it does once an output's sign is changed (pyfit.gap.polarity): DiagnoseError naming that output and the
+    sidecar's fix, before any effect is tried."""
+    if best <= cfg.nominal_max_nrmse:
+        return
+    change = polarity.sign_change(system, fmu, cal, cfg.nominal_budget, cfg.upsample, workers or os.cpu_count() or 1,
+                                  nominal.calibration_nrmse, cfg.nominal_max_nrmse)
+    if change is None:
+        return
+    which = ", ".join(change.outputs)
+    raise DiagnoseError(
+        f"{data_dir}: the nominal model fits no calibration file as recorded (NRMSE {change.nrmse_as_recorded:.2f}) "
+        f"but fits them with the sign of {which} changed (NRMSE {change.nrmse_changed:.2f}): "
+        + ("every output's sign convention, or the input's, is" if change.every_output else
+           "that sensor's sign convention is") + " the model's opposite; allowed: the model's convention, e.g. "
+        f"`invert = true` on the column{'s' if len(change.outputs) > 1 else ''} recorded as {which} in every sidecar "
+        "(or on the input's), once the sensor's mounting is checked")
+
+
 def fmu_defaults(runner: FmuRunner) -> dict[str, float]:
     """The FMU's parameter start values (the .mo defaults), SI."""
     return {v.name: float(v.start) for v in runner.model_description.modelVariables
@@ -812,6 +833,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     sims = {"nominal": _simulated(runner, records, nominal.params, system, cfg)}
     bands = [tuple(b) for b in cfg.bands_hz] if cfg.bands_hz else localise.default_bands(records)
     gap = report.nominal_gap(sims["nominal"], records, held, bands, cfg)
+    _check_signs(system, fmu, cal, cfg, nominal, report.best_calibration_nrmse(gap)[0], data_dir, workers)
     clock.end("where (nominal gap)")
     screening, fits, selected = {}, {}, None
     effects = cfg.effects or list(system.effects)

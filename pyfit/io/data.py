@@ -1,7 +1,8 @@
 """Measurement files (theory §5): a CSV plus a TOML sidecar of the same stem.
 
 Sidecar keys: model, sample_rate_hz, [inputs] and [outputs] mapping column -> {unit, model_variable[, weight,
-sensitivity]} (sensitivity: a voltage column's sensor, e.g. "100 mV/g": read as what the sensor measures);
+sensitivity, invert]} (sensitivity: a voltage column's sensor, e.g. "100 mV/g": read as what the sensor measures;
+invert = true: a sensor whose sign convention is the model's opposite, read with its sign changed);
 optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s" or "ms"), columns (the
 names of the columns of a file without a header line, in order).
 
@@ -89,6 +90,7 @@ class Channel:
     weight: float = 1.0
     volts_per_unit: float | None = None
     measures: str | None = None  # the unit the sensitivity is per (None: the column's own unit)
+    invert: bool = False  # the sensor's sign convention is the model's opposite: read with its sign changed
 
     @property
     def quantity_unit(self) -> str:
@@ -97,10 +99,11 @@ class Channel:
 
     @property
     def to_si(self) -> float:
-        """SI units of the measured quantity per number in the file."""
+        """SI units of the measured quantity, in the model's sign convention, per number in the file."""
+        sign = -1.0 if self.invert else 1.0
         if self.volts_per_unit is None:
-            return TO_SI[self.unit]
-        return TO_SI[self.unit] / self.volts_per_unit * TO_SI[self.measures]
+            return sign * TO_SI[self.unit]
+        return sign * TO_SI[self.unit] / self.volts_per_unit * TO_SI[self.measures]
 
 
 SENSITIVITY = re.compile(r"^\s*([0-9.]+(?:[eE][+-]?[0-9]+)?)\s*(V|mV)\s*/\s*(\S+)\s*$")
@@ -155,7 +158,8 @@ def _channels(side, table, section) -> dict[str, Channel]:
     for col, spec in table.items():
         c = check_table(spec, side, f"{section}.{col}", {"unit": (str, True, None), "model_variable": (str, True, None),
                                                          "weight": ("number", False, 1.0),
-                                                         "sensitivity": (str, False, None)}, MeasurementError)
+                                                         "sensitivity": (str, False, None),
+                                                         "invert": (bool, False, False)}, MeasurementError)
         c["unit"] = unit_key(c["unit"])
         if c["unit"] not in TO_SI:
             fail(side, f"{section}.{col}.unit", f"'{c['unit']}' unknown", ", ".join(TO_SI), MeasurementError)
@@ -163,7 +167,7 @@ def _channels(side, table, section) -> dict[str, Channel]:
             fail(side, f"{section}.{col}.weight", f"{c['weight']} is not > 0", error=MeasurementError)
         volts, per = (_sensitivity(side, f"{section}.{col}.sensitivity", c["sensitivity"], c["unit"])
                       if c["sensitivity"] is not None else (None, None))
-        out[col] = Channel(col, c["unit"], c["model_variable"], c["weight"], volts, per)
+        out[col] = Channel(col, c["unit"], c["model_variable"], c["weight"], volts, per, c["invert"])
     return out
 
 
