@@ -1,8 +1,10 @@
 """Sim-to-real gap diagnosis of SDOF datasets, continued: no false alarm on null datasets (noise seeds 1 and 2
-under -m slow), a skew between the channels named sensor_delay, clear errors on bad input, the linear start
-from the measured FRF of accelerometer records under band-limited noise (three more noise seeds under -m slow)."""
+under -m slow), a skew between the channels named sensor_delay, clear errors on bad input (a sensor recorded in
+the model's opposite sign convention among them), the linear start from the measured FRF of accelerometer records
+under band-limited noise (three more noise seeds under -m slow)."""
 import dataclasses
 import json
+import re
 import shutil
 
 import numpy as np
@@ -12,6 +14,7 @@ from gap_cases import CI, case
 from pyfit.gap import campaign, datasets
 from pyfit.gap import diagnose as dg
 from pyfit.gap import simulate as sim
+from pyfit.gap.polarity import with_signs_changed
 from pyfit.gap.systems import sdof_start
 from pyfit.io.data import read_measurement
 
@@ -64,6 +67,40 @@ def test_bad_input_gives_one_clear_error(data_root, tmp_path, fmu_dir):
     cfg.write_text("[diagnose]\nrefit_budget = 'many'\n")
     with pytest.raises(dg.DiagnoseError, match=r"\[diagnose\.refit_budget\] must be a whole number, not 'many'"):
         dg.load_config(cfg)
+
+
+def test_a_sensor_recorded_in_the_opposite_sign_convention_is_named_with_its_fix(data_root, tmp_path, fmu_dir):
+    """A load cell reading tension where the model's force is compression, an accelerometer mounted the other way
+    up: the null case's output written in the opposite convention (`invert = true` in every sidecar). The nominal
+    then fits no calibration file, and fits them once that output's sign is changed: the diagnosis stops there,
+    naming it and the sidecar's fix, before trying any effect."""
+    data = tmp_path / "inverted"
+    shutil.copytree(case(data_root, "none", 0), data)
+    flipped = []
+    for side in sorted(data.glob("*.toml")):
+        text = side.read_text()
+        outputs = text[text.index("[outputs]"):]
+        flipped += re.findall(r"model_variable = \"(\w+)\"", outputs)
+        side.write_text(text.replace(outputs, re.sub(r"^(\S+ = \{.*?) \}$", r"\1, invert = true }", outputs,
+                                                     flags=re.M)))
+    assert flipped and len(set(flipped)) == 1, flipped  # the SDOF records one output
+    with pytest.raises(dg.DiagnoseError) as err:
+        dg.diagnose("sdof", data, tmp_path / "out", CI, fmu_dir, workers=2, progress=False)
+    msg = str(err.value)
+    found = re.search(r"fits no calibration file as recorded \(NRMSE ([\d.]+)\) but fits them with the sign of "
+                      rf"{flipped[0]} changed \(NRMSE ([\d.]+)\)", msg)
+    assert found, msg
+    as_recorded, changed = map(float, found.groups())
+    # as recorded no better than predicting zero; changed in sign within the nominal's own fit criterion
+    assert as_recorded > 0.95 and changed <= CI.nominal_max_nrmse, msg
+    assert "`invert = true` on the column recorded as" in msg and str(data) in msg and "\n" not in msg
+
+
+def test_signs_are_changed_only_on_the_outputs_named():
+    rec = sim.Record("r", "1", 1.0, 100.0, {"u": np.ones(4)}, {"y": np.arange(4.0), "a": np.ones(4)}, 0)
+    (changed,) = with_signs_changed([rec], ("y",))
+    assert np.array_equal(changed.outputs["y"], -np.arange(4.0)) and np.array_equal(changed.outputs["a"], np.ones(4))
+    assert changed.inputs is rec.inputs and np.array_equal(rec.outputs["y"], np.arange(4.0))  # the record kept
 
 
 def test_a_skew_between_the_channels_is_named_sensor_delay(data_root, fmu_dir, measured):
