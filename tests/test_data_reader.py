@@ -332,6 +332,7 @@ def test_a_voltage_with_its_sensor_s_sensitivity_reads_what_the_sensor_measures(
     ("mV", "100 mV/furlong", r"'100 mV/furlong' is not a sensitivity"),
     ("mV", "1 V/mV", r"'1 V/mV' is not a sensitivity"),
     ("mV", "0 mV/g", r"'0 mV/g' is not a sensitivity"),
+    ("mV", "1.2.3 mV/g", r"'1.2.3 mV/g' is not a sensitivity"),  # no number: refused, not a crash
 ])
 def test_a_sensitivity_that_cannot_be_read_is_refused_naming_the_field(tmp_path, unit, sensitivity, says):
     with pytest.raises(MeasurementError, match=says + r".*allowed: '<number> V/<unit>' or '<number> mV/<unit>'"):

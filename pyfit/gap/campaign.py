@@ -278,11 +278,11 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
         progress: bool = True, calibrate: bool = False, model: str = "sdof", config: str | None = None,
         excitation: str | None = None) -> dict:
     """Draw n cases of `model` (every one under `excitation` when given: draw) and diagnose them: on `scheduler`
-    (a Dask scheduler address) when given, else on a Dask LocalCluster of `workers` single-threaded processes. Writes OUT/summary.md and OUT/summary.json (a
-    campaign whose every case is stored is summarised again, with the wall time of the run that diagnosed them);
-    with `calibrate`, its hit rates become the package's confidence calibration of `model` with its settings
-    (pyfit.gap.confidence), and the summary states every report's confidence with it (in-sample); `config`: a
-    TOML file of diagnosis settings (pyfit.gap.diagnose.load_config; default: the defaults)."""
+    (a Dask scheduler address) when given, else on a Dask LocalCluster of `workers` single-threaded processes.
+    Writes OUT/summary.md and OUT/summary.json (a campaign whose every case is stored is summarised again, with
+    the wall time of the run that diagnosed them: wall_of_runs); with `calibrate`, its hit rates become the
+    package's confidence calibration of `model` with its settings (pyfit.gap.confidence), and the summary states
+    every report's confidence with it (in-sample); `config`: a TOML file of diagnosis settings (pyfit.gap.diagnose.load_config; default: the defaults)."""
     if calibrate and excitation:
         raise ValueError("--calibrate takes a campaign of every excitation (a report's confidence is read from it "
                          "whatever its records); drop --excitation")

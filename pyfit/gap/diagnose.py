@@ -719,12 +719,12 @@ def _check_signs(system, fmu: str, cal: list, cfg: DiagnoseConfig, nominal: Fit,
     if best <= cfg.nominal_max_nrmse:
         return
     change = polarity.sign_change(system, fmu, cal, cfg.nominal_budget, cfg.upsample, workers or os.cpu_count() or 1,
-                                  nominal.calibration_nrmse, cfg.nominal_max_nrmse)
+                                  cfg.nominal_max_nrmse)
     if change is None:
         return
     which = ", ".join(change.outputs)
     raise DiagnoseError(
-        f"{data_dir}: the nominal model fits no calibration file as recorded (NRMSE {change.nrmse_as_recorded:.2f}) "
+        f"{data_dir}: the nominal model fits no calibration file as recorded (NRMSE {nominal.calibration_nrmse:.2f}) "
         f"but fits them with the sign of {which} changed (NRMSE {change.nrmse_changed:.2f}): "
         + ("every output's sign convention, or the input's, is" if change.every_output else
            "that sensor's sign convention is") + " the model's opposite; allowed: the model's convention, e.g. "

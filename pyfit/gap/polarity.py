@@ -16,11 +16,10 @@ from pyfit.gap.attribute import nominal_task, run_fit
 
 @dataclass(frozen=True)
 class SignChange:
-    """Outputs (model variables) whose sign changed lets the nominal fit: the calibration NRMSE before and after."""
+    """Outputs (model variables) whose sign changed lets the nominal fit, and its calibration NRMSE then."""
 
     outputs: tuple[str, ...]
     every_output: bool  # all of them: the input's sign convention may be the one that differs
-    nrmse_as_recorded: float
     nrmse_changed: float
 
 
@@ -30,16 +29,16 @@ def with_signs_changed(records: list, outputs: tuple[str, ...]) -> list:
             for r in records]
 
 
-def sign_change(system, fmu: str, cal: list, budget: int, upsample: int, threads: int, misfit: float,
+def sign_change(system, fmu: str, cal: list, budget: int, upsample: int, threads: int,
                 max_nrmse: float) -> SignChange | None:
     """The outputs whose sign changed lets the nominal model fit the calibration records `cal` (its calibration
-    NRMSE at most `max_nrmse`, from `misfit` as recorded); None when no such change does. Each output alone is
-    tried first, then all of them."""
+    NRMSE at most `max_nrmse`); None when no such change does. Each output alone is tried first, then all of
+    them."""
     names = tuple(cal[0].outputs)
     trials = [(k,) for k in names] + ([names] if len(names) > 1 else [])
     for outputs in trials:
         fit = run_fit(nominal_task(system, fmu, with_signs_changed(cal, outputs), budget, upsample, threads))
         if fit.calibration_nrmse <= max_nrmse:
-            return SignChange(outputs, outputs == names, misfit, fit.calibration_nrmse)
+            return SignChange(outputs, outputs == names, fit.calibration_nrmse)
     return None
 

@@ -106,7 +106,7 @@ class Channel:
         return sign * TO_SI[self.unit] / self.volts_per_unit * TO_SI[self.measures]
 
 
-SENSITIVITY = re.compile(r"^\s*([0-9.]+(?:[eE][+-]?[0-9]+)?)\s*(V|mV)\s*/\s*(\S+)\s*$")
+SENSITIVITY = re.compile(r"^\s*((?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*(V|mV)\s*/\s*(\S+)\s*$")
 
 
 def _sensitivity(side, where: str, text: str, unit: str) -> tuple[float, str]:
@@ -116,7 +116,7 @@ def _sensitivity(side, where: str, text: str, unit: str) -> tuple[float, str]:
                "mV column")
     if QUANTITY[unit] != "voltage":
         fail(side, where, f"on a column in '{unit}', not a voltage", allowed, MeasurementError)
-    match = SENSITIVITY.match(text) if isinstance(text, str) else None
+    match = SENSITIVITY.match(text)
     per = unit_key(match.group(3)) if match else ""
     if not match or per not in TO_SI or QUANTITY[per] == "voltage" or not float(match.group(1)) > 0:
         fail(side, where, f"{text!r} is not a sensitivity", allowed, MeasurementError)
@@ -239,8 +239,7 @@ def _first_row(lines: list[tuple[int, str]], wanted: list[str], columns: list[st
     `wanted` column in as many fields as the line below it holds, or that splits into as many numbers as
     `columns` has names; the first line when none does (which is then refused, naming its row)."""
     for k, (_, line) in enumerate(lines[:PREAMBLE_LINES]):
-        if columns and any(len(f) == len(columns) and all(_numeric(v, d) for v in f)
-                           for d in DELIMITERS + (SPACES,) for f in [_fields(line, d)]):
+        if columns and _splitting(line, len(columns)) is not None:
             return k
         below = lines[k + 1][1] if k + 1 < len(lines) else ""
         delimiter = _delimiter(line, below)
@@ -284,23 +283,28 @@ def _header(csv_path: pathlib.Path, text: str, wanted: list[str] = (), columns: 
     return _Header(names, skip, delimiter, units)
 
 
+def _splitting(line: str, n: int) -> str | None:
+    """The first of ',', a tab, ';' and spaces that splits `line` into `n` numbers (None when none does)."""
+    return next((d for d in DELIMITERS + (SPACES,)
+                 if len(f := _fields(line, d)) == n and all(_numeric(v, d) for v in f)), None)
+
+
 def _unnamed(csv_path: pathlib.Path, line: str, row: int, columns: list[str], above=None) -> _Header:
     """The header of a file without a header line whose first data line is `line` (row `row`): the sidecar's
-    `columns`, and the delimiter that splits that line into as many numbers (',', a tab, ';', spaces: the
-    first that does). The line `above` it ((row, line), None when there is none) must not be a header: as many
-    fields, none a number (the columns it names could be in another order than the sidecar's)."""
-    for delimiter in DELIMITERS + (SPACES,):
-        fields = _fields(line, delimiter)
-        if len(fields) == len(columns) and all(_numeric(v, delimiter) for v in fields):
-            names = _fields(above[1], delimiter) if above else []
-            if len(names) == len(columns) and not any(_numeric(v, delimiter) for v in names):
-                raise MeasurementError(f"{csv_path}: row {above[0]} names the columns ({', '.join(names)}) but the "
-                                       f"sidecar's `columns` names them too ({', '.join(columns)}); allowed: one of "
-                                       "the two (a file with a header line: no `columns` in the sidecar)")
-            return _Header(list(columns), row - 1, delimiter, {})
-    raise MeasurementError(f"{csv_path}: row {row} does not split into {len(columns)} numbers (the sidecar's "
-                           f"columns: {', '.join(columns)}); allowed: one number per named column, separated by ',', "
-                           "a tab, ';' or spaces (a file with a header line: no `columns` in the sidecar)")
+    `columns`, and the delimiter that splits that line into as many numbers (_splitting). The line `above` it
+    ((row, line), None when there is none) must not be a header: as many fields, none a number (the columns it
+    names could be in another order than the sidecar's)."""
+    delimiter = _splitting(line, len(columns))
+    if delimiter is None:
+        raise MeasurementError(f"{csv_path}: row {row} does not split into {len(columns)} numbers (the sidecar's "
+                               f"columns: {', '.join(columns)}); allowed: one number per named column, separated by "
+                               "',', a tab, ';' or spaces (a file with a header line: no `columns` in the sidecar)")
+    names = _fields(above[1], delimiter) if above else []
+    if len(names) == len(columns) and not any(_numeric(v, delimiter) for v in names):
+        raise MeasurementError(f"{csv_path}: row {above[0]} names the columns ({', '.join(names)}) but the "
+                               f"sidecar's `columns` names them too ({', '.join(columns)}); allowed: one of "
+                               "the two (a file with a header line: no `columns` in the sidecar)")
+    return _Header(list(columns), row - 1, delimiter, {})
 
 
 def _load_columns(csv_path, text: str, head: _Header, wanted: list[str]) -> dict[str, np.ndarray]:
