@@ -56,7 +56,22 @@ def test_default_nominal_damper_keeps_the_design_eccentric_masses():
 
 @pytest.mark.parametrize("text,match", [
     ('[nominal]\nfamily = "beam"\n', r"\[nominal.family\] unknown family 'beam'; allowed: sdof, damper"),
-    ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = "heavy"\n', r"\[nominal.fixed.m1\] must be a number"),
+    ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = "heavy"\n',
+     r"\[nominal.fixed.m1\] 'heavy': not a number followed by a unit; allowed: a number in SI units, or a string"),
+    ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = "1.2 kilo"\n', r"\[nominal.fixed.m1\] '1.2 kilo': unknown unit"),
+    ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = true\n', r"\[nominal.fixed.m1\] must be a number \(SI\) or"),
+    # a unit slip: millimetres, grams, kg·mm² written as SI numbers, and a unit of another quantity
+    ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nL1 = 150\n',
+     r"\[nominal.fixed.L1\] 150 m is not what a Stockbridge damper has \(0.01 to 3 m\); the file's numbers are SI"),
+    ('[nominal]\nfamily = "damper"\n[nominal.free]\nEI = { start = 1.2e7 }\n',
+     r"\[nominal.free.EI.start\] 1.2e\+07 N.m2 is not what a Stockbridge damper has"),
+    ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = 1200\n', r"\[nominal.fixed.m1\] 1200 kg is not what"),
+    ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = 1.0\nJ_G1 = 2.0\n',
+     r"\[nominal.fixed.J_G1\] J_G1 / m1 gives a radius of gyration of 1.41e\+03 mm, not a damper mass's \(3 to 500 mm\)"),
+    ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nL1 = "150 g"\n',
+     r"\[nominal.fixed.L1\] 'g' is a mass \(kg\), but L1 is in m; allowed: a number in m or a value in a unit of a length"),
+    ('[nominal]\nfamily = "damper"\n[nominal.free]\nEI = { start = "12 N.m2", lower = "4 N.m", upper = 40.0 }\n',
+     r"\[nominal.free.EI.lower\] 'N.m' is kg.m2/s2, but nominal.free.EI.start is in 'N.m2'"),
     ('[nominal]\nfamily = "damper"\n[nominal.free]\nEI = { start = 50.0, lower = 1.0, upper = 30.0 }\n',
      r"\[nominal.free.EI.start\] 50.0 outside \[1.0, 30.0\]"),
     ('[nominal]\nfamily = "damper"\n[nominal.free]\nEI = { lower = 1.0 }\n', r"\[nominal.free.EI\] give both lower and upper"),
@@ -71,11 +86,63 @@ def test_bad_nominal_files_name_file_and_key(tmp_path, text, match):
         load_nominal(f)
 
 
-def test_unknown_parameter_names_the_valid_ones(tmp_path):
+def test_values_written_with_units_read_to_the_si_numbers_of_the_same_damper(tmp_path):
+    """The described damper above in the units of a drawing (g, cm, mm, in, kg·mm², N·mm²): the same SI numbers
+    as written out by the definitions (1 in = 25.4 mm exact)."""
+    f = tmp_path / "drawing.toml"
+    f.write_text("""
+[nominal]
+family = "damper"
+[nominal.fixed]
+m1 = "1000 g"
+m2 = "1 kg"
+L1 = "15 cm"
+L2 = "5.905511811023622 in"
+J_G1 = "2000 kg·mm²"
+J_G2 = "2e-3 kg.m2"
+a1 = "20 mm"
+a2 = 0.02
+[nominal.free]
+EI = { start = "12 N·m²", lower = "4e6 N*mm^2", upper = 36.0 }
+alpha_pd = { start = "1.5 1/s" }
+""")
+    (tmp_path / "si.toml").write_text(DESCRIBED)
+    drawn, si = load_nominal(f), load_nominal(tmp_path / "si.toml")
+    assert drawn.fixed.keys() == si.fixed.keys() and drawn.free.keys() == si.free.keys()
+    for name, value in si.fixed.items():
+        assert drawn.fixed[name] == pytest.approx(value, rel=1e-14), name
+    assert drawn.free["EI"].lower == pytest.approx(4.0, rel=1e-14) and drawn.free["EI"].start == 12.0
+    assert drawn.free["alpha_pd"].start == 1.5
+    assert drawn.units["L1"][0] == "nominal.fixed.L1" and drawn.units["L1"][1].text == "cm"
+
+
+def test_unknown_parameter_names_the_valid_ones(tmp_path, fmu_dir):
+    from pyfit.runtime.fmu import FmuRunner
+
     f = tmp_path / "n.toml"
     f.write_text('[nominal]\nfamily = "damper"\n[nominal.fixed]\nmass1 = 1.0\n')
-    with pytest.raises(ConfigError, match=r"n.toml: \[nominal.fixed.mass1\] not a parameter of the model; allowed: EI, L1"):
-        load_nominal(f).check_names({"EI", "L1"})
+    with pytest.raises(ConfigError, match=r"n.toml: \[nominal.fixed.mass1\] not a parameter of the model; allowed: A, D, EI, "):
+        load_nominal(f).check_against(FmuRunner(str(fmu_dir / "StockbridgeDamper.fmu")).parameters())
+
+
+@pytest.mark.parametrize("fmu, text, match", [
+    ("SDOFBoucWen", '[nominal]\nfamily = "sdof"\n[nominal.fixed]\nk = "5e4 N"\n',
+     r"\[nominal.fixed.k\] 'N' is a force \(kg.m/s2\), but k is in N/m; allowed: a number in N/m or a value in a unit "
+     r"of kg/s2"),
+    ("SDOFBoucWen", '[nominal]\nfamily = "sdof"\n[nominal.fixed]\nbeta = "1000 1/m"\n',
+     r"\[nominal.fixed.beta\] '1/m' is 1/m, but beta is in no declared unit; allowed: a number"),
+    ("SDOFBoucWen", '[nominal]\nfamily = "sdof"\n[nominal.free]\nm = { start = -2.0 }\n',
+     r"\[nominal.free.m\] -2 is outside the model's range; allowed: 0.0 to inf kg"),
+    ("StockbridgeDamper", '[nominal]\nfamily = "damper"\n[nominal.free]\nalpha_pd = { start = 1.0, lower = -1.0, '
+     'upper = 5.0 }\n', r"\[nominal.free.alpha_pd\] -1 is outside the model's range; allowed: 0.0 to inf 1/s"),
+])
+def test_a_nominal_is_checked_against_the_units_and_ranges_the_fmu_declares(tmp_path, fmu_dir, fmu, text, match):
+    from pyfit.runtime.fmu import FmuRunner
+
+    f = tmp_path / "n.toml"
+    f.write_text(text)
+    with pytest.raises(ConfigError, match=match):
+        load_nominal(f).check_against(FmuRunner(str(fmu_dir / f"{fmu}.fmu")).parameters())
 
 
 def test_frf_peaks_of_a_linear_sdof_sweep_give_its_natural_frequency_and_damping(measured):

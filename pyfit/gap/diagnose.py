@@ -777,7 +777,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
         if described.family != model:
             raise DiagnoseError(f"{described.path}: [nominal.family] = '{described.family}' but the diagnosis is "
                                 f"of '{model}'")
-        described.check_names(set(runner.parameter_names()))
+        described.check_against(runner.parameters())
     system = make_system(model, fmu_defaults(runner), described)
     if users:
         system = _with_user_candidates(system, users, set(runner.parameter_names()))

@@ -165,7 +165,7 @@ def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu
         if described.family != "damper":
             raise DiagnoseError(f"{described.path}: [nominal.family] = '{described.family}'; an impedance test is "
                                 "of a damper")
-        described.check_names(set(runner.parameter_names()))
+        described.check_against(runner.parameters())
     defaults = fmu_defaults(runner)
     system = make_system("damper", defaults, described)
     runner.close()

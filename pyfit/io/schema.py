@@ -73,7 +73,8 @@ def check_table(table: dict, path, section: str, spec: dict, error: type[ConfigE
     """Check a TOML table against spec {key: (type, required, default)}; return the values with defaults.
 
     type: a Python type (int and float accept whole numbers; float converts them), "number" (int or float,
-    returned as float), "floats" (list of numbers), "strings" (a string or a list of strings)."""
+    returned as float), "floats" (list of numbers), "strings" (a string or a list of strings), None (any value:
+    the caller checks it)."""
     if not isinstance(table, dict):
         fail(path, section or "file", f"must be a table, not {table!r}", error=error)
     unknown = set(table) - set(spec)
@@ -104,7 +105,7 @@ def check_table(table: dict, path, section: str, spec: dict, error: type[ConfigE
         elif typ is int:
             if not isinstance(value, int) or isinstance(value, bool):
                 fail(path, where, f"must be a whole number, not {value!r}", error=error)
-        elif not isinstance(value, typ):
+        elif typ is not None and not isinstance(value, typ):
             fail(path, where, f"must be {typ.__name__}, not {value!r}", error=error)
         out[key] = value
     return out

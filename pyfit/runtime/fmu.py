@@ -126,7 +126,11 @@ class FmuRunner:
 
     def parameter_names(self) -> list[str]:
         """Names of the parameters that can be set before a run."""
-        return [v.name for v in self.model_description.modelVariables if v.causality == "parameter"]
+        return list(self.parameters())
+
+    def parameters(self) -> dict:
+        """The parameters that can be set before a run: name -> fmpy ScalarVariable (unit, min, max, start)."""
+        return {v.name: v for v in self.model_description.modelVariables if v.causality == "parameter"}
 
     def instance(self):
         """The loaded fmpy FMU instance of this process (instantiated on first use; reset between runs)."""
