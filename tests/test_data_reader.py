@@ -4,7 +4,8 @@ import pathlib
 import numpy as np
 import pytest
 
-from pyfit.io.data import MeasurementError, check_quantities, read_dataset_with_order, read_measurement
+from pyfit.io.data import (MeasurementError, check_quantities, holds_measurements, read_dataset_with_order,
+                           read_measurement)
 
 FS = 750.0
 N = 26251  # 35 s at 750 Hz: t = 35 s written with 6 significant digits is off by up to 5e-5 s = 0.04 sample
@@ -172,6 +173,35 @@ def test_levels_ordered_by_value_then_excitation_then_input_rms(tmp_path):
                                                     + r.split(",")[3:]) for r in text[3:] if r] ) + "\n")
     items, basis = read_dataset_with_order(d)
     assert basis == "input RMS" and [m.path.stem for m in items] == ["f1", "f0", "f2"]
+
+
+def test_a_dataset_s_files_are_found_by_their_sidecars_whatever_their_extension(tmp_path):
+    """A DAQ's LEVEL1.CSV, a text export's .txt and .dat, each beside its sidecar, read to the numbers of a .csv
+    twin; a README.txt without a sidecar is no measurement; a CSV without one, or two files sharing one, is
+    refused naming the fix."""
+    d = tmp_path / "lab"
+    d.mkdir()
+    for i, (name, suffix) in enumerate([("LEVEL1", ".CSV"), ("level2", ".txt"), ("level3", ".dat")]):
+        p = lab_file(d, name, level=i + 1.0, amp=1.0 + i)
+        p.rename(p.with_suffix(suffix))
+    (d / "README.txt").write_text("bench 2, December, three levels\n")
+    twin = read_measurement(lab_file(tmp_path, "twin", level=2.0, amp=2.0))
+    items, basis = read_dataset_with_order(d)
+    assert [m.path.name for m in items] == ["LEVEL1.CSV", "level2.txt", "level3.dat"] and basis == "level_value"
+    assert np.array_equal(items[1].values["x_mm"], twin.values["x_mm"])
+    (d / "level4.csv").write_text("t,x_mm,F_kN\n0,0,0\n")
+    with pytest.raises(MeasurementError, match=r"level4.csv: no sidecar level4.toml"):
+        read_dataset_with_order(d)
+    (d / "level4.csv").unlink()
+    (d / "level3.txt").write_bytes((d / "level3.dat").read_bytes())
+    with pytest.raises(MeasurementError, match=r"level3.dat and level3.txt share the sidecar level3.toml; allowed: one"):
+        read_dataset_with_order(d)
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (empty / "README.txt").write_text("nothing yet\n")
+    with pytest.raises(MeasurementError, match=r"no measurement found \(a file ending in .csv, .txt"):
+        read_dataset_with_order(empty)
+    assert holds_measurements(d) and not holds_measurements(empty)  # which folders `diagnose --cases` takes
 
 
 def _export(tmp_path, header: str, rows: list[str], unit_x: str = "mm") -> pathlib.Path:

@@ -10,6 +10,7 @@ import time
 
 from pyfit.gap.diagnose import DiagnoseConfig, diagnose
 from pyfit.gap.impedance_gap import diagnose_impedance
+from pyfit.io.data import holds_measurements
 from pyfit.io.schema import read_toml
 
 
@@ -27,7 +28,7 @@ def run_cases(root, out_dir, cfg: DiagnoseConfig | None = None, model: str = "sd
     """Diagnose every sub-folder of root holding a dataset (against the nominal model described, if any);
     OUT/<case>/report.*, OUT/summary.md."""
     rows = []
-    for case in sorted(p for p in pathlib.Path(root).iterdir() if p.is_dir() and any(p.glob("*.csv"))):
+    for case in sorted(p for p in pathlib.Path(root).iterdir() if p.is_dir() and holds_measurements(p)):
         t0 = time.perf_counter()
         test = impedance_test_in(case)
         if test:

@@ -119,9 +119,6 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
         ms, order = read_dataset_with_order(data_dir)
     except MeasurementError as exc:
         raise DiagnoseError(str(exc)) from exc
-    missing = [p.name for p in sorted(data_dir.glob("*.csv")) if not p.with_suffix(".toml").is_file()]
-    if missing:
-        raise DiagnoseError(f"{data_dir / missing[0]}: no sidecar {pathlib.Path(missing[0]).stem}.toml")
     if len(ms) < 2:
         raise DiagnoseError(f"{data_dir}: a diagnosis needs at least two files (one to calibrate on, one held "
                             f"out); found {len(ms)}")

@@ -27,7 +27,7 @@ import numpy as np
 
 from pyfit.analysis import kinematics
 from pyfit.gap import simulate as sim
-from pyfit.io.data import read_measurement
+from pyfit.io.data import measurement_files, read_measurement
 
 LIBRARY = {"y^3": "cubic_stiffness", "tanh(v/v_s)": "coulomb_friction", "v|v|": "quadratic_damping"}
 SIGNIFICANT = 0.01  # a first term is named when it removes at least this share of the linear model's residual
@@ -67,7 +67,7 @@ def read_motions(folder: pathlib.Path) -> list[Motion]:
     """Every measurement file of an SDOF dataset folder as force and motion (displacement y or acceleration a
     recorded; the rest derived, pyfit.analysis.kinematics)."""
     out = []
-    for csv in sorted(pathlib.Path(folder).glob("*.csv")):
+    for csv in measurement_files(folder):
         rec = sim.record_of(read_measurement(csv))
         u = rec.inputs["u"][rec.first:]
         recorded = {k: rec.outputs[name] for k, name in (("x", "y"), ("a", "a")) if name in rec.outputs}

@@ -1,4 +1,4 @@
-"""Measurement files (theory §5): a CSV plus a TOML sidecar of the same stem.
+"""Measurement files (theory §5): a CSV (or .txt, .dat, .tsv, .asc; any case) plus a TOML sidecar of the same stem.
 
 Sidecar keys: model, sample_rate_hz, [inputs] and [outputs] mapping column -> {unit, model_variable[, weight,
 sensitivity, invert]} (sensitivity: a voltage column's sensor, e.g. "100 mV/g": read as what the sensor measures;
@@ -524,16 +524,45 @@ def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool
     return volts
 
 
-def read_dataset_with_order(folder: str | pathlib.Path) -> tuple[list[Measurement], str]:
-    """All measurements in a folder, ordered by level, and what the order rests on."""
+DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc")  # a measurement file's extensions, in any case
+
+
+def measurement_files(folder: str | pathlib.Path) -> list[pathlib.Path]:
+    """The measurement files of a dataset folder: each file ending in one of DATA_SUFFIXES (any case: a DAQ's
+    LEVEL1.CSV) beside a TOML sidecar of its stem. A CSV without a sidecar is refused; another text file
+    without one (a README.txt) is not a measurement. Two files sharing one sidecar are refused."""
     folder = pathlib.Path(folder)
     if not folder.is_dir():
         raise MeasurementError(f"{folder}: dataset folder not found")
-    items = [read_measurement(p) for p in sorted(folder.glob("*.csv"))]
+    found = []
+    for p in sorted(folder.iterdir()):
+        if not (p.is_file() and p.suffix.lower() in DATA_SUFFIXES):
+            continue
+        if p.with_suffix(".toml").is_file():
+            found.append(p)
+        elif p.suffix.lower() == ".csv":
+            raise MeasurementError(f"{p}: no sidecar {p.stem}.toml")
+    for a, b in zip(found, found[1:]):
+        if a.stem == b.stem:
+            raise MeasurementError(f"{folder}: {a.name} and {b.name} share the sidecar {a.stem}.toml; allowed: one "
+                                   "measurement file per sidecar")
+    return found
+
+
+def holds_measurements(folder: pathlib.Path) -> bool:
+    """Whether a folder holds a measurement file beside its sidecar (as measurement_files finds them)."""
+    return any(f.suffix.lower() in DATA_SUFFIXES and f.with_suffix(".toml").is_file() for f in folder.iterdir())
+
+
+def read_dataset_with_order(folder: str | pathlib.Path) -> tuple[list[Measurement], str]:
+    """All measurements in a folder (measurement_files), ordered by level, and what the order rests on."""
+    items = [read_measurement(p) for p in measurement_files(folder)]
     if not items:
-        raise MeasurementError(f"{folder}: no measurement (CSV + TOML) found")
+        raise MeasurementError(f"{folder}: no measurement found (a file ending in "
+                               f"{', '.join(DATA_SUFFIXES)} beside a TOML sidecar of its stem)")
     return level_order(items)
 
 
-__all__ = ["Channel", "Measurement", "MeasurementError", "QUANTITY", "TO_SI", "check_quantities", "level_order",
-           "read_dataset", "read_dataset_with_order", "read_measurement", "unit_key", "write_measurement"]
+__all__ = ["Channel", "DATA_SUFFIXES", "Measurement", "MeasurementError", "QUANTITY", "TO_SI", "check_quantities",
+           "holds_measurements", "level_order", "measurement_files", "read_dataset", "read_dataset_with_order", "read_measurement", "unit_key",
+           "write_measurement"]
