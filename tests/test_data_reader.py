@@ -94,6 +94,35 @@ def test_rate_within_rounding_is_accepted(tmp_path):
     assert m.sample_rate_hz == pytest.approx(FS, rel=1e-12)
 
 
+def _without_rate(path: pathlib.Path) -> pathlib.Path:
+    side = path.with_suffix(".toml")
+    side.write_text("\n".join(line for line in side.read_text().split("\n") if "sample_rate_hz" not in line))
+    return path
+
+
+@pytest.mark.parametrize("rate, time_fmt", [(FS, "%.6g"), (2560.0, "%.6g"), (1000.0 / 3.0, "%.9g")])
+def test_a_sidecar_without_a_rate_takes_the_time_column_s(tmp_path, rate, time_fmt):
+    """Stamps rounded to 6 significant digits (up to 5e-5 s off over 35 s) give the DAQ's rate to 1e-7, put on its
+    6 digits; a rate with no short decimal form (1000/3 Hz) is kept as the stamps give it."""
+    t = np.arange(N) / rate
+    m = read_measurement(_without_rate(lab_file(tmp_path, time_fmt=time_fmt, t=t)))
+    assert m.sample_rate_hz == pytest.approx(rate, rel=1e-7)
+    if rate != 1000.0 / 3.0:
+        assert 1.0 / (m.t[1] - m.t[0]) == pytest.approx(rate, rel=1e-12)  # snapped: the rate the DAQ was set to
+    assert np.max(np.abs(m.t - t)) < 0.25 / rate
+
+
+def test_a_sidecar_without_a_rate_needs_a_time_column_and_a_uniform_one(tmp_path):
+    with pytest.raises(MeasurementError, match=r"run.toml: \[sample_rate_hz\] missing, and run.csv has no time "
+                                               r"column 't' to take the rate from; allowed: the rate in Hz"):
+        read_measurement(_without_rate(lab_file(tmp_path, time=False)))
+    t = np.arange(N) / FS
+    t[N // 2:] += 0.4 / FS  # a clock that slips by 0.4 samples half way
+    with pytest.raises(MeasurementError, match=r"run.csv: row \d+: t = .* samples off the uniform grid of the "
+                                               r"column's rate \(7\d\d\.\d+ Hz\)"):
+        read_measurement(_without_rate(lab_file(tmp_path, time_fmt="%.10g", t=t)))
+
+
 @pytest.mark.parametrize("sep", [";", "\t"])
 def test_decimal_commas_between_semicolons_or_tabs_read_to_the_same_numbers(tmp_path, sep):
     """A spreadsheet's export in a locale that writes decimal commas: ';' or a tab between the columns, so a
@@ -401,3 +430,63 @@ def test_an_inverted_sensor_is_read_in_the_model_s_sign_convention(tmp_path):
     side.write_text(side.read_text().replace("invert = true", 'invert = "yes"'))
     with pytest.raises(MeasurementError, match=r"\[outputs.x.invert\] must be bool, not 'yes'"):
         read_measurement(path)
+
+
+def _mat_twin(tmp_path, name: str, layout: str, **savemat) -> tuple[pathlib.Path, object]:
+    """A MATLAB file holding the columns of lab_file's CSV in one of the layouts a lab saves them in, beside the
+    CSV's sidecar (plus `columns` for a matrix), and the CSV's own reading."""
+    import scipy.io
+
+    csv = lab_file(tmp_path, name)
+    twin = read_measurement(csv)
+    data = np.loadtxt(csv, delimiter=",", skiprows=3, usecols=(0, 1, 2))
+    t, x, force = data.T
+    side = csv.with_suffix(".toml").read_text()
+    if layout == "vectors":  # save('run.mat', 't', 'x_mm', 'F_kN') of column vectors, and a text note beside them
+        content = {"t": t[:, None], "x_mm": x[:, None], "F_kN": force[:, None], "operator": "X"}
+    elif layout == "struct":  # one struct per channel set: the sidecar names 'daq.x_mm'
+        content = {"daq": {"t": t, "x_mm": x, "F_kN": force}}
+        side = side.replace("F_kN =", '"daq.F_kN" =').replace("x_mm =", '"daq.x_mm" =')
+        side = 'time_column = "daq.t"\n' + side
+    else:  # one matrix, a channel per row (3 x N), and a calibration vector of another length beside it
+        content = {"data": data.T, "cal": np.array([1.0, 2.0])}
+        side = 'columns = ["t", "x_mm", "F_kN"]\n' + side
+    csv.unlink()
+    mat = csv.with_suffix(".mat")
+    scipy.io.savemat(mat, content, **savemat)
+    mat.with_suffix(".toml").write_text(side)
+    return mat, twin
+
+
+@pytest.mark.parametrize("layout, savemat", [("vectors", {}), ("vectors", {"format": "4"}), ("struct", {}),
+                                             ("matrix", {"do_compression": True})])
+def test_a_matlab_file_reads_to_the_numbers_of_its_csv_twin(tmp_path, layout, savemat):
+    mat, twin = _mat_twin(tmp_path, "run", layout, **savemat)
+    m = read_measurement(mat)
+    key = "daq.x_mm" if layout == "struct" else "x_mm"
+    assert np.array_equal(m.values[key], twin.values["x_mm"]) and np.array_equal(m.t, twin.t)
+    assert np.array_equal(m.values[key.replace("x_mm", "F_kN")], twin.values["F_kN"])
+    items, _ = read_dataset_with_order(tmp_path)
+    assert [i.path.name for i in items] == ["run.mat"]
+
+
+def test_a_matlab_file_that_cannot_be_used_is_refused_naming_the_fix(tmp_path):
+    import struct
+
+    mat, _ = _mat_twin(tmp_path, "run", "vectors")
+    side = mat.with_suffix(".toml")
+    side.write_text(side.read_text().replace("x_mm =", "x =", 1))
+    with pytest.raises(MeasurementError, match=r"run.mat: variable 'x' named in run.toml is missing; vectors: t, "
+                                               r"x_mm, F_kN; allowed: a MATLAB file of format v4 to v7.2"):
+        read_measurement(mat)
+    side.write_text('columns = ["t", "x_mm"]\n' + side.read_text())
+    with pytest.raises(MeasurementError, match=r"\[columns\] 2 names, and run.mat holds 0 matrices"):
+        read_measurement(mat)
+    # MATLAB's -v7.3 format is HDF5: its 128-byte header says so (version 0x0200)
+    header = b"MATLAB 7.3 MAT-file, HDF5 schema 1.00 .".ljust(116) + bytes(8) + struct.pack("<H", 0x0200) + b"IM"
+    mat.write_bytes(header + bytes(512))
+    with pytest.raises(MeasurementError, match=r"run.mat: a MATLAB v7.3 \(HDF5\) file; allowed: .*'-v7'"):
+        read_measurement(mat)
+    mat.write_bytes(b"t,x_mm\n0,1\n" * 30)
+    with pytest.raises(MeasurementError, match=r"run.mat: not readable as a MATLAB file"):
+        read_measurement(mat)

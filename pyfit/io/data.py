@@ -1,8 +1,11 @@
-"""Measurement files (theory §5): a CSV (or .txt, .dat, .tsv, .asc; any case) plus a TOML sidecar of the same stem.
+"""Measurement files (theory §5): a CSV (or .txt, .dat, .tsv, .asc; any case) plus a TOML sidecar of the same stem,
+or a MATLAB .mat file (v4 to v7.2: scipy.io.loadmat) whose vectors, a struct's fields ('s.x') or one matrix's
+columns (named by the sidecar's `columns`) are the columns.
 
-Sidecar keys: model, sample_rate_hz, [inputs] and [outputs] mapping column -> {unit, model_variable[, weight,
-sensitivity, invert]} (sensitivity: a voltage column's sensor, e.g. "100 mV/g": read as what the sensor measures;
-invert = true: a sensor whose sign convention is the model's opposite, read with its sign changed);
+Sidecar keys: model, sample_rate_hz (optional where the file has a time column: its rate, rate_of), [inputs]
+and [outputs] mapping column -> {unit, model_variable[, weight, sensitivity, invert]} (sensitivity: a voltage
+column's sensor, e.g. "100 mV/g": read as what the sensor measures; invert = true: a sensor whose sign convention
+is the model's opposite, read with its sign changed);
 optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s" or "ms"), columns (the
 names of the columns of a file without a header line, in order).
 
@@ -60,7 +63,7 @@ TIME_UNITS = {"s": 1.0, "ms": 1e-3}
 MAX_ABS_SI = 1e100  # largest magnitude of a measured value in SI units: its square over a million samples,
 #                      and its derivatives at MHz rates, stay far inside double precision (1.8e308)
 MAX_TIME_SLIP = 0.25  # largest allowed distance [samples] of a time stamp from the uniform grid
-SIDECAR = {"model": (str, True, None), "sample_rate_hz": ("number", True, None), "inputs": (dict, False, {}),
+SIDECAR = {"model": (str, True, None), "sample_rate_hz": ("number", False, None), "inputs": (dict, False, {}),
            "outputs": (dict, True, None), "level": (str, False, ""), "level_value": ("number", False, None),
            "excitation": (dict, False, {}), "notes": (str, False, ""), "time_column": (str, False, "t"),
            "time_unit": (str, False, "s"), "columns": ("strings", False, None)}
@@ -336,8 +339,21 @@ def read_csv_columns(csv_path, wanted: list[str]) -> dict[str, np.ndarray]:
     return _load_columns(csv_path, text, head, wanted)
 
 
-def check_time(t: np.ndarray, fs: float, csv_path, side, column: str, first_row: int) -> None:
-    """A time column [s] must be the uniform grid of fs within MAX_TIME_SLIP samples (rounding allowed)."""
+def rate_of(t: np.ndarray) -> float:
+    """The sample rate [Hz] of a time column (a sidecar without sample_rate_hz): the least-squares slope of the
+    stamps against their index (rounded stamps average out), put on its 6 significant digits (the rate a DAQ is
+    set to) when within 1e-7 of them."""
+    k = np.arange(len(t), dtype=float)
+    with np.errstate(all="ignore"):  # a time column that is not finite or not increasing is refused by check_time
+        slope = np.polyfit(k, t, 1)[0] if len(t) > 1 and np.all(np.isfinite(t)) else np.nan
+    fs = 1.0 / slope if slope > 0 else 1.0
+    nice = float(f"{fs:.6g}")
+    return nice if abs(nice / fs - 1) < 1e-7 else fs
+
+
+def check_time(t: np.ndarray, fs: float, csv_path, side, column: str, first_row: int, stated: bool = True) -> None:
+    """A time column [s] must be the uniform grid of fs (the sidecar's, or where not `stated` the column's own:
+    rate_of) within MAX_TIME_SLIP samples (rounding allowed)."""
     if len(t) < 2:
         raise MeasurementError(f"{csv_path}: fewer than two samples")
     bad = np.flatnonzero(~np.isfinite(t))
@@ -360,34 +376,23 @@ def check_time(t: np.ndarray, fs: float, csv_path, side, column: str, first_row:
             raise MeasurementError(f"{csv_path}: row {first_row + k}: {column} = {t[k]:.10g} s follows "
                                    f"{t[k - 1]:.10g} s: a gap of {step:.3g} samples; allowed: one sample "
                                    f"(1/{fs:g} s) between rows")
+        if not stated:
+            raise MeasurementError(f"{csv_path}: row {first_row + k}: {column} = {t[k]:.10g} s is {slip[k]:+.2f} "
+                                   f"samples off the uniform grid of the column's rate ({fs:.9g} Hz); allowed: "
+                                   f"within {MAX_TIME_SLIP} samples")
         rate = (len(t) - 1) / (t[-1] - t[0])
         raise MeasurementError(f"{side}: [sample_rate_hz] = {fs:g} but column '{column}' is sampled at "
                                f"{rate:.9g} Hz (row {first_row + k}, {column} = {t[k]:.10g} s, is "
                                f"{slip[k]:+.2f} samples off the grid; allowed: within {MAX_TIME_SLIP} samples)")
 
 
-def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
-    """Read one CSV + TOML pair (the sidecar has the same stem); validate and convert to SI."""
-    csv_path = pathlib.Path(csv_path)
-    side = csv_path.with_suffix(".toml")
-    if not csv_path.is_file():
-        raise MeasurementError(f"{csv_path}: file not found")
-    meta = check_table(read_toml(side, MeasurementError), side, "", SIDECAR, MeasurementError)
-    columns = meta["columns"]
-    if columns is not None and (not columns or len(set(columns)) < len(columns)):
-        fail(side, "columns", f"{columns} names no column or one twice", "the names of the file's columns, each "
-             "once, in order", MeasurementError)
-    fs = meta["sample_rate_hz"]
-    if not fs > 0:
-        fail(side, "sample_rate_hz", f"{fs} is not > 0", error=MeasurementError)
-    if meta["time_unit"] not in TIME_UNITS:
-        fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join(TIME_UNITS), MeasurementError)
-    inputs = _channels(side, meta["inputs"], "inputs")
-    outputs = _channels(side, meta["outputs"], "outputs")
+def _text_columns(csv_path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
+    """The used columns of a text file (the time column's first, if the file has it), the time column's name (or
+    None) and the rows above the first sample (error messages count rows from there)."""
     text = read_text(csv_path, MeasurementError)
-    head = _header(csv_path, text, list({**inputs, **outputs}), meta["columns"])
+    head = _header(csv_path, text, list(channels), meta["columns"])
     names, skip = head.names, head.skip
-    for name, ch in {**inputs, **outputs}.items():
+    for name, ch in channels.items():
         if name not in names:
             raise MeasurementError(f"{csv_path}: column '{name}' named in {side.name} is missing; "
                                    f"columns: {', '.join(names)}")
@@ -401,11 +406,87 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
         raise MeasurementError(f"{csv_path}: row {skip}: the units row gives '{head.units[time_col]}' for the time "
                                f"column '{time_col}' but {side.name} says time_unit = '{meta['time_unit']}'; "
                                "allowed: the same unit in both")
-    cols = _load_columns(csv_path, text, head, ([time_col] if time_col else []) + list({**inputs, **outputs}))
+    return _load_columns(csv_path, text, head, ([time_col] if time_col else []) + list(channels)), time_col, skip
+
+
+MAT_ALLOWED = ("a MATLAB file of format v4 to v7.2 (MATLAB's default; save(..., '-v7') for a v7.3 file) holding "
+               "the columns as vectors of one length, as fields of a struct ('s.x'), or as the columns of one "
+               "matrix the sidecar's `columns` names")
+
+
+def _mat_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
+    """The used columns of a MATLAB file (scipy.io.loadmat), as _text_columns gives a text file's: vectors by
+    their names, a struct's fields as 'struct.field', or the columns (or rows) of the one matrix whose size
+    matches the sidecar's `columns`, by those names."""
+    import scipy.io
+
+    try:
+        raw = scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False)
+    except NotImplementedError as exc:  # scipy's answer to a v7.3 (HDF5) file
+        raise MeasurementError(f"{path}: a MATLAB v7.3 (HDF5) file; allowed: {MAT_ALLOWED}") from exc
+    except (ValueError, TypeError, OSError, scipy.io.matlab.MatReadError) as exc:  # not a MATLAB file
+        raise MeasurementError(f"{path}: not readable as a MATLAB file ({exc}); allowed: {MAT_ALLOWED}") from exc
+    found = {}
+    for name, v in raw.items():
+        if name.startswith("__"):
+            continue
+        fields = getattr(v, "_fieldnames", None)
+        found.update({f"{name}.{f}": getattr(v, f) for f in fields} if fields else {name: v})
+    arrays = {n: np.asarray(v) for n, v in found.items()
+              if np.asarray(v).dtype.kind in "biuf" and np.asarray(v).ndim in (1, 2)}
+    if meta["columns"] is not None:
+        k = len(meta["columns"])
+        matrices = [n for n, a in arrays.items() if a.ndim == 2 and k in a.shape]
+        if len(matrices) != 1:
+            fail(side, "columns", f"{k} names, and {path.name} holds {len(matrices)} matrices with {k} columns or "
+                 f"rows ({', '.join(matrices) or 'none'})", MAT_ALLOWED, MeasurementError)
+        m = arrays[matrices[0]]
+        vectors = dict(zip(meta["columns"], (m if m.shape[1] == k else m.T).T))
+    else:
+        vectors = {n: a for n, a in arrays.items() if a.ndim == 1}
+    time_col = meta["time_column"] if meta["time_column"] in vectors else None
+    used = ([time_col] if time_col else []) + list(channels)
+    for name in used:
+        if name not in vectors:
+            raise MeasurementError(f"{path}: variable '{name}' named in {side.name} is missing; vectors: "
+                                   f"{', '.join(vectors) or 'none'}; allowed: {MAT_ALLOWED}")
+    lengths = {name: len(vectors[name]) for name in used}
+    if len(set(lengths.values())) > 1 or min(lengths.values()) < 2:
+        raise MeasurementError(f"{path}: the used vectors differ in length or hold fewer than two samples "
+                               f"({', '.join(f'{n}: {k}' for n, k in lengths.items())}); allowed: {MAT_ALLOWED}")
+    return {name: vectors[name].astype(float) for name in used}, time_col, 0
+
+
+def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
+    """Read one measurement file (text, or MATLAB's .mat) and its TOML sidecar (the same stem); validate and
+    convert to SI."""
+    csv_path = pathlib.Path(csv_path)
+    side = csv_path.with_suffix(".toml")
+    if not csv_path.is_file():
+        raise MeasurementError(f"{csv_path}: file not found")
+    meta = check_table(read_toml(side, MeasurementError), side, "", SIDECAR, MeasurementError)
+    columns = meta["columns"]
+    if columns is not None and (not columns or len(set(columns)) < len(columns)):
+        fail(side, "columns", f"{columns} names no column or one twice", "the names of the file's columns, each "
+             "once, in order", MeasurementError)
+    fs = meta["sample_rate_hz"]
+    if fs is not None and not fs > 0:
+        fail(side, "sample_rate_hz", f"{fs} is not > 0", error=MeasurementError)
+    if meta["time_unit"] not in TIME_UNITS:
+        fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join(TIME_UNITS), MeasurementError)
+    inputs = _channels(side, meta["inputs"], "inputs")
+    outputs = _channels(side, meta["outputs"], "outputs")
+    read = _mat_columns if csv_path.suffix.lower() == ".mat" else _text_columns
+    cols, time_col, skip = read(csv_path, side, meta, {**inputs, **outputs})
     n = len(next(iter(cols.values())))
+    if fs is None and not time_col:
+        fail(side, "sample_rate_hz", f"missing, and {csv_path.name} has no time column '{meta['time_column']}' to "
+             "take the rate from", "the rate in Hz, or time_column naming the file's time column", MeasurementError)
     if time_col:
         t_file = cols.pop(time_col) * TIME_UNITS[meta["time_unit"]]
-        check_time(t_file, fs, csv_path, side, time_col, skip + 1)
+        stated = fs is not None
+        fs = fs if stated else rate_of(t_file)
+        check_time(t_file, fs, csv_path, side, time_col, skip + 1, stated)
         t0 = float(np.mean(t_file - np.arange(n) / fs))  # the grid that fits the rounded stamps best
     else:
         t0 = 0.0
@@ -524,7 +605,7 @@ def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool
     return volts
 
 
-DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc")  # a measurement file's extensions, in any case
+DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc", ".mat")  # a measurement file's extensions, in any case
 
 
 def measurement_files(folder: str | pathlib.Path) -> list[pathlib.Path]:
@@ -564,5 +645,5 @@ def read_dataset_with_order(folder: str | pathlib.Path) -> tuple[list[Measuremen
 
 
 __all__ = ["Channel", "DATA_SUFFIXES", "Measurement", "MeasurementError", "QUANTITY", "TO_SI", "check_quantities",
-           "holds_measurements", "level_order", "measurement_files", "read_dataset", "read_dataset_with_order", "read_measurement", "unit_key",
-           "write_measurement"]
+           "holds_measurements", "level_order", "measurement_files", "read_dataset", "read_dataset_with_order",
+           "read_measurement", "unit_key", "write_measurement"]
