@@ -1,6 +1,7 @@
-"""The default split of a dataset into calibration and held-out files (pyfit.gap.diagnose._load): the files of the
-lowest and the highest level calibrate and the levels between are held out (of three levels, the middle one), so that
-more levels add held-out evidence, not simulations to every fit; of two levels, the first file calibrates."""
+"""The default split of a dataset into calibration and held-out files (pyfit.gap.diagnose.default_calibration, through
+_load): the files of the lowest and the highest level calibrate and the levels between are held out (of three levels,
+the middle one), so that more levels add held-out evidence, not simulations to every fit; of two levels, the files of
+the lower calibrate; of one level in several files, every other one."""
 import numpy as np
 import pytest
 
@@ -35,7 +36,52 @@ def test_the_lowest_and_highest_levels_calibrate_and_the_levels_between_are_held
     assert sorted({r.level_value for r in data.held}) == sorted(set(levels) - calibrated)
 
 
-def test_of_two_levels_the_first_file_calibrates(tmp_path, sdof_system):
+@pytest.mark.parametrize("repeats", [1, 3])
+def test_of_two_levels_the_lower_level_s_files_calibrate(tmp_path, sdof_system, repeats):
+    """Two levels in one file each, or in several (a sweep up and down, a stepped sine's frequencies)."""
     runner, system = sdof_system
-    data = dg._load(_dataset(tmp_path, (10.0, 20.0)), system, dg.DiagnoseConfig(), runner)
-    assert [r.level_value for r in data.cal] == [10.0] and [r.level_value for r in data.held] == [20.0]
+    data = dg._load(_dataset(tmp_path, (10.0, 20.0), repeats), system, dg.DiagnoseConfig(), runner)
+    assert [r.level_value for r in data.cal] == [10.0] * repeats
+    assert [r.level_value for r in data.held] == [20.0] * repeats
+
+
+@pytest.mark.parametrize("files, calibrated", [(2, [0]), (3, [0, 2]), (6, [0, 2, 4])])
+def test_of_one_level_in_several_files_every_other_one_calibrates(files, calibrated):
+    """One level in several files (a stepped sine's frequencies, repeated runs): the calibration spans them, so
+    that a nominal is not fitted to one frequency and judged at all the others."""
+
+    class Rec:
+        def __init__(self, i):
+            self.name, self.level_value = f"f{i}", 10.0
+
+    records = [Rec(i) for i in range(files)]
+    assert [r.name for r in dg.default_calibration(records)] == [f"f{i}" for i in calibrated]
+
+
+@pytest.mark.slow
+def test_a_stepped_sine_recorded_a_file_per_frequency_is_diagnosed(tmp_path, fmu_dir, measured):
+    """Two levels (15, 45 N) of six sines (0.6-1.5 x the resonance) in a file each, written by the CasADi reference
+    with a cubic spring of a strength drawn log-uniformly over a decade, 0.5 % noise on force and displacement.
+    The lower level's six files calibrate (one file, one frequency, could not place the resonance) and the
+    spring is named with its strength."""
+    from pyfit.analysis.excitation import Excitation
+    from pyfit.gap import datasets
+    from pyfit.reference.synthetic import SyntheticSpec, simulate_truth
+
+    rng = np.random.default_rng(5)
+    k3 = float(np.exp(rng.uniform(np.log(5e7), np.log(5e8))))
+    truth = {**datasets.SDOF.linear, "k3": k3}
+    for level in (15.0, 45.0):
+        for f in np.round(35.6 * np.geomspace(0.6, 1.5, 6), 2):
+            t, y, u = simulate_truth(SyntheticSpec("SDOFBoucWen", Excitation(1, level, f, f, t_ramp=0.5), 4.0, 500.0,
+                                                   ["y"], truth, seed=int(f * 100)))
+            noisy = {k: v + 0.005 * np.std(v) * rng.standard_normal(len(t)) for k, v in (("y", y["y"]), ("u", u["u"]))}
+            write_measurement(tmp_path / "data" / f"L{level:g}N_f{f:g}Hz.csv", "SDOFBoucWen", t,
+                              {"F": (noisy["u"], "N", "u")}, {"y": (noisy["y"], "m", "y")}, level=f"{level:g} N",
+                              level_value=level, excitation={"kind": "sine", "frequency_hz": float(f)})
+    rep = dg.diagnose("sdof", tmp_path / "data", tmp_path / "out", fmu_dir=fmu_dir, workers=2)
+    assert rep["calibration_files"] == sorted(p.stem for p in (tmp_path / "data").glob("L15N_*.csv"))
+    assert rep["verdict"] == "gap explained by cubic_stiffness", rep["verdict"]
+    fitted = next(r for r in rep["ranking"] if r["effect"] == "cubic_stiffness")["params"]["k3"]
+    measured("stepped sine in a file per frequency (SDOF, cubic spring drawn over a decade): fitted k3 vs the "
+             "truth, relative", abs(fitted / k3 - 1), 0.03)

@@ -38,7 +38,7 @@ class DiagnoseConfig:
     """Settings of a diagnosis (all optional)."""
 
     effects: list | None = None  # candidate effects to test (default: all of the system's)
-    calibration: list | None = None  # file stems to calibrate on (default: the lowest and the highest level's)
+    calibration: list | None = None  # file stems to calibrate on (default: default_calibration)
     bands_hz: list | None = None  # [[lo, hi], ...] (default: localise.default_bands, 8 over the excited range)
     nominal_budget: int = 60  # FMU evaluations of the nominal calibration
     refit_budget: int = 120  # FMU evaluations per refit with an effect
@@ -106,6 +106,20 @@ class Dataset:
     rate: AnalysisRate  # the rate the records are analysed at (the files' or decimated: pyfit.gap.rate)
 
 
+def default_calibration(records: list) -> list:
+    """The records calibrated on by default (`records` ordered by level): of three levels or more, every file of
+    the lowest and of the highest level (the levels between are held out: more levels hold more out, not more into
+    every fit's simulations); of two, every file of the lower (the higher is held out); of one, every other file
+    from the first (a dataset of one level in several files, e.g. a stepped sine's frequencies: the calibration
+    spans them), the first alone of two files."""
+    levels = sorted({r.level_value for r in records})
+    if len(levels) >= 3:
+        return [r for r in records if r.level_value in (levels[0], levels[-1])]
+    if len(levels) == 2:
+        return [r for r in records if r.level_value == levels[0]]
+    return records[::2] if len(records) >= 3 else records[:1]
+
+
 def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
     """Records of the dataset, validated against the FMU's variables and their units, split into calibration
     and held-out."""
@@ -164,11 +178,8 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
         if bad:
             raise DiagnoseError(f"calibration: no file '{bad[0]}' in {data_dir}; files: {', '.join(names)}")
         cal = [r for r in records if r.name in cfg.calibration]
-    else:  # the lowest and the highest level calibrate and the levels between are held out (of three: the middle
-        # one); of two, the first file calibrates. More levels hold more out, not more into every fit's simulations
-        levels = sorted({r.level_value for r in records})
-        ends = (levels[0], levels[-1])
-        cal = [r for r in records if r.level_value in ends] if len(levels) >= 3 else records[:1]
+    else:
+        cal = default_calibration(records)
     held = [r for r in records if r not in cal]
     if not held or not cal:
         raise DiagnoseError(f"calibration: the split leaves {'no held-out' if not held else 'no calibration'} file")
