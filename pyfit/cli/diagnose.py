@@ -13,6 +13,7 @@ MODELS = ("sdof", "damper")  # the system families (pyfit.gap.systems.FAMILY), n
 EXAMPLE = """examples:
   stockbridge diagnose --model damper --data my_sweeps/ --nominal my_damper.toml --out results/diagnose
   stockbridge diagnose --model sdof --data my_tests/
+  stockbridge diagnose --model sdof --data my_tests/ --check  # what would be read, in seconds, before any fit
   stockbridge diagnose --model sdof --data my_tests/ --candidates my_candidates.toml  # your own effects too
   stockbridge diagnose --impedance damper_test.csv --uncertainty 0.01      # an IEC 61897 impedance test
   stockbridge diagnose --make-datasets cases/ --excitation sweep --record a # withheld-effect test cases
@@ -31,6 +32,9 @@ def add_arguments(ap) -> None:
     ap.add_argument("--model", default="sdof", choices=MODELS,
                     help="nominal model: sdof (linear SDOF) or damper (linear FE damper)")
     ap.add_argument("--data", help="dataset folder (CSV + TOML pairs)")
+    ap.add_argument("--check", action="store_true", help="with --data: print what the diagnosis would read "
+                    "(files, levels, channels and units, RMS in SI, noise floor, split, excited band, the nominal's "
+                    "resonances) and stop before any fit")
     ap.add_argument("--config", help="TOML with a [diagnose] table")
     ap.add_argument("--nominal", help="TOML describing your system: [nominal] family, fixed and free parameters "
                                       "(default: the FMU's own; for the damper the reference damper)")
@@ -73,6 +77,7 @@ def add_arguments(ap) -> None:
 def run(args, ap) -> int:
     """Dispatch to the dataset writer, the case runner, the impedance or the measurement diagnosis."""
     from pyfit.gap import campaign, cases, datasets
+    from pyfit.gap.dataset_check import check_dataset, check_text
     from pyfit.gap.diagnose import diagnose, load_config
     from pyfit.gap.impedance_gap import diagnose_impedance
     from pyfit.io import benchmark_data
@@ -106,6 +111,9 @@ def run(args, ap) -> int:
                 args.data = benchmark_data.write_dataset(pathlib.Path(args.out) / "data")
             if not args.data:
                 ap.error("--data is required (or --impedance, --benchmark, --make-datasets, --cases)")
+            if args.check:
+                print(check_text(check_dataset(args.model, args.data, args.nominal, cfg, args.fmus, args.candidates)))
+                return 0
             report = diagnose(args.model, args.data, args.out, cfg, args.fmus, args.workers, nominal=args.nominal,
                               candidates=args.candidates)
     except (ConfigError, ValueError, OSError) as exc:  # OSError: a file not found, a scheduler not answering

@@ -25,7 +25,7 @@ from pyfit.gap import band, confidence, localise, polarity, selection, user_cand
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, nominal_task, pinned, run_fit, screen
 from pyfit.gap.rate import AnalysisRate, analysis_rate, at_rate, drive_upsample
-from pyfit.gap.systems import combine, family_fmu, make_system, strength_grid
+from pyfit.gap.systems import System, combine, family_fmu, make_system, strength_grid
 from pyfit.io.nominal import NominalModel, load_nominal
 
 
@@ -758,6 +758,59 @@ def _with_user_candidates(system, users, fmu_parameters: set):
     return dataclasses.replace(system, effects={**system.effects, **users.effects})
 
 
+@dataclass
+class Prepared:
+    """A diagnosis's inputs read and checked (prepare): the FMU and its runner, the system with the described
+    nominal and the user's candidates, the dataset split, the settings asked for and those used (the drive's
+    upsampling set), the excited band [Hz] and the nominal start's linear modes."""
+
+    fmu: str
+    runner: FmuRunner
+    system: System
+    described: NominalModel | None
+    users: user_candidates.UserCandidates | None
+    data: Dataset
+    requested: DiagnoseConfig
+    cfg: DiagnoseConfig
+    band: tuple[float, float]
+    modes: list
+
+
+def prepare(model: str, data_dir, cfg: DiagnoseConfig, fmu_dir="fmus", nominal: NominalModel | str | None = None,
+            candidates=None) -> Prepared:
+    """Read and check everything a diagnosis takes before its first fit: the nominal description against the
+    FMU, the user's candidates, the dataset against the FMU's variables and units, its split, and that the
+    excited band holds a resonance of the nominal (or of a start from the measured peaks); DiagnoseError
+    otherwise."""
+    users = user_candidates.load(candidates) if isinstance(candidates, (str, pathlib.Path)) else candidates
+    fmu = str(users.fmu) if users and users.fmu else str(ensure_fmu(family_fmu(model), pathlib.Path(fmu_dir)))
+    runner = FmuRunner(fmu)
+    described = load_nominal(nominal) if isinstance(nominal, (str, pathlib.Path)) else nominal
+    if described is not None:
+        if described.family != model:
+            raise DiagnoseError(f"{described.path}: [nominal.family] = '{described.family}' but the diagnosis is "
+                                f"of '{model}'")
+        described.check_against(runner.parameters())
+    system = make_system(model, fmu_defaults(runner), described)
+    if users:
+        system = _with_user_candidates(system, users, set(runner.parameter_names()))
+    data = _load(data_dir, system, cfg, runner)
+    lo, hi = localise.excited_range(data.records)
+    modes = linear_modes(fmu, {**system.nominal_fixed, **system.start(data.cal)})
+
+    def in_band(start):  # a start whose linear model has a resonance in the excited band
+        return any(lo <= m.f_n <= hi for m in linear_modes(fmu, {**system.nominal_fixed, **start}))
+
+    if modes and not any(lo <= m.f_n <= hi for m in modes) and \
+            not any(in_band(s) for s in system.data_starts(data.cal, lambda p: linear_modes(fmu, p))):
+        raise DiagnoseError(f"{data_dir}: the inputs excite {lo:.1f}-{hi:.1f} Hz but the nominal model's resonances "
+                            f"are at {', '.join(f'{m.f_n:.1f}' for m in modes)} Hz and no start from the measured "
+                            "resonance peaks moves one into that band; allowed: an excitation band that holds at "
+                            "least one resonance (the data cannot calibrate the model otherwise)")
+    return Prepared(fmu, runner, system, described, users, data, cfg, with_drive(cfg, system, data.rate), (lo, hi),
+                    modes)
+
+
 @_on_one_blas_thread
 def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, fmu_dir="fmus",
              workers: int | None = None, progress: bool = True, nominal: NominalModel | str | None = None,
@@ -776,34 +829,10 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
 
     clock = StageClock()
 
-    cfg = cfg or DiagnoseConfig()
-    users = user_candidates.load(candidates) if isinstance(candidates, (str, pathlib.Path)) else candidates
-    fmu = str(users.fmu) if users and users.fmu else str(ensure_fmu(family_fmu(model), pathlib.Path(fmu_dir)))
-    runner = FmuRunner(fmu)
-    described = load_nominal(nominal) if isinstance(nominal, (str, pathlib.Path)) else nominal
-    if described is not None:
-        if described.family != model:
-            raise DiagnoseError(f"{described.path}: [nominal.family] = '{described.family}' but the diagnosis is "
-                                f"of '{model}'")
-        described.check_against(runner.parameters())
-    system = make_system(model, fmu_defaults(runner), described)
-    if users:
-        system = _with_user_candidates(system, users, set(runner.parameter_names()))
-    data = _load(data_dir, system, cfg, runner)
-    requested, cfg = cfg, with_drive(cfg, system, data.rate)
+    p = prepare(model, data_dir, cfg or DiagnoseConfig(), fmu_dir, nominal, candidates)
+    fmu, runner, system, described, users, data = p.fmu, p.runner, p.system, p.described, p.users, p.data
+    requested, cfg = p.requested, p.cfg
     records, cal, held, data_key = data.records, data.cal, data.held, data.key
-    lo, hi = localise.excited_range(records)
-    modes = linear_modes(fmu, {**system.nominal_fixed, **system.start(cal)})
-
-    def in_band(start):  # a start whose linear model has a resonance in the excited band
-        return any(lo <= m.f_n <= hi for m in linear_modes(fmu, {**system.nominal_fixed, **start}))
-
-    if modes and not any(lo <= m.f_n <= hi for m in modes) and \
-            not any(in_band(s) for s in system.data_starts(cal, lambda p: linear_modes(fmu, p))):
-        raise DiagnoseError(f"{data_dir}: the inputs excite {lo:.1f}-{hi:.1f} Hz but the nominal model's resonances "
-                            f"are at {', '.join(f'{m.f_n:.1f}' for m in modes)} Hz and no start from the measured "
-                            "resonance peaks moves one into that band; allowed: an excitation band that holds at "
-                            "least one resonance (the data cannot calibrate the model otherwise)")
     clock.end("reading and checking the data")
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)
