@@ -223,7 +223,8 @@ def test_a_dataset_s_files_are_found_by_their_sidecars_whatever_their_extension(
         read_dataset_with_order(d)
     (d / "level4.csv").unlink()
     (d / "level3.txt").write_bytes((d / "level3.dat").read_bytes())
-    with pytest.raises(MeasurementError, match=r"level3.dat and level3.txt share the sidecar level3.toml; allowed: one"):
+    with pytest.raises(MeasurementError, match=r"level3.dat and level3.txt share the sidecar level3.toml; "
+                                               r"allowed: one"):
         read_dataset_with_order(d)
     empty = tmp_path / "empty"
     empty.mkdir()
@@ -490,3 +491,46 @@ def test_a_matlab_file_that_cannot_be_used_is_refused_naming_the_fix(tmp_path):
     mat.write_bytes(b"t,x_mm\n0,1\n" * 30)
     with pytest.raises(MeasurementError, match=r"run.mat: not readable as a MATLAB file"):
         read_measurement(mat)
+
+
+def test_a_file_holding_several_levels_reads_as_one_measurement_per_segment(tmp_path):
+    """Three levels recorded one after the other in one file, cut by the sidecar's [[segments]]: each segment
+    reads to the numbers of the level written in a file of its own, under the name 'file#k', its level and
+    level_value its segment's, and the dataset orders them by level like separate files."""
+    n = 1500
+    apart, one = tmp_path / "apart", tmp_path / "one"
+    apart.mkdir()
+    one.mkdir()
+    parts = {level: lab_file(apart, f"L{level:g}", level=level, amp=level, t=np.arange(n) / FS)
+             for level in (2.0, 1.0, 3.0)}
+    rows = []
+    for k, level in enumerate((2.0, 1.0, 3.0)):  # not in level order: the segments are ordered by their levels
+        body = parts[level].read_text().split("\n")[3:]
+        rows += [f"{(k * n + i) / FS:.10g}," + r.split(",", 1)[1] for i, r in enumerate(b for b in body if b)]
+    (one / "run.csv").write_text('"t","x_mm","F_kN","status","T_room"\n' + "\n".join(rows) + "\n")
+    side = parts[1.0].with_suffix(".toml").read_text().replace("level_value = 1.0\n", "")
+    segments = "".join(f"[[segments]]\nfrom_s = {k * n / FS!r}\nto_s = {(k + 1) * n / FS!r}\nlevel = \"{lv:g} mm\"\n"
+                       f"level_value = {lv}\n" for k, lv in enumerate((2.0, 1.0, 3.0)))
+    (one / "run.toml").write_text(side + segments)
+    items, basis = read_dataset_with_order(one)
+    assert basis == "level_value" and [m.name for m in items] == ["run#2", "run#1", "run#3"]
+    for m in items:
+        alone = read_measurement(parts[m.level_value])
+        assert m.level == f"{m.level_value:g} mm" and len(m.t) == n
+        assert np.array_equal(m.values["x_mm"], alone.values["x_mm"])
+        assert np.array_equal(m.values["F_kN"], alone.values["F_kN"])
+
+
+@pytest.mark.parametrize("segments, says", [
+    ("[[segments]]\nfrom_s = 1.0\nto_s = 0.5\n", r"\[segments\[0\]\] from_s = 1 s to to_s = 0.5 s holds 0 samples"),
+    ("[[segments]]\nfrom_s = 40.0\nto_s = 50.0\n", r"holds 0 samples; allowed: from_s < to_s, at least two"),
+    ("[[segments]]\nfrom_s = 0.0\nto_s = 10.0\n[[segments]]\nfrom_s = 9.0\nto_s = 20.0\n",
+     r"\[segments\[1\]\] from_s = 9 s lies inside segments\[0\] \(0-10 s\); allowed: segments that do not overlap"),
+    ("[[segments]]\nfrom = 0.0\nto_s = 10.0\n", r"\[segments\[0\].from\] unknown key; allowed: excitation, from_s"),
+])
+def test_segments_that_cannot_be_cut_are_refused_naming_the_table(tmp_path, segments, says):
+    path = lab_file(tmp_path)
+    side = path.with_suffix(".toml")
+    side.write_text(side.read_text() + segments)
+    with pytest.raises(MeasurementError, match=says):
+        read_measurement(path)

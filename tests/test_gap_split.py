@@ -85,3 +85,37 @@ def test_a_stepped_sine_recorded_a_file_per_frequency_is_diagnosed(tmp_path, fmu
     fitted = next(r for r in rep["ranking"] if r["effect"] == "cubic_stiffness")["params"]["k3"]
     measured("stepped sine in a file per frequency (SDOF, cubic spring drawn over a decade): fitted k3 vs the "
              "truth, relative", abs(fitted / k3 - 1), 0.03)
+
+
+@pytest.mark.slow
+def test_one_continuous_record_of_three_levels_cut_by_segments_is_diagnosed(tmp_path, fmu_dir, measured):
+    """One record holding three levels one after the other (a 5-80 Hz log sweep at 10, 25 then 50 N, 6 s each, the
+    response carried over between them: the later segments do not start at rest), simulated by the CasADi
+    reference with a cubic spring drawn log-uniformly over a decade, written as one file whose sidecar cuts it
+    into three [[segments]]: the ends calibrate, the middle is held out, and the spring is named with its
+    strength."""
+    from pyfit.gap import datasets
+    from pyfit.reference import integrate, models
+
+    rng = np.random.default_rng(11)
+    k3 = float(np.exp(rng.uniform(np.log(5e7), np.log(5e8))))
+    fs, over, stage, f0, f1 = 500.0, 10, 6.0, 5.0, 80.0
+    t_fine = np.arange(int(3 * stage * fs * over)) / (fs * over)
+    ts = np.mod(t_fine, stage)
+    amp = np.select([t_fine < stage, t_fine < 2 * stage], [10.0, 25.0], 50.0)
+    u = amp * np.sin(2 * np.pi * f0 * stage / np.log(f1 / f0) * (np.exp(ts / stage * np.log(f1 / f0)) - 1))
+    y = integrate.simulate_cvodes(models.by_name("SDOFBoucWen"), t_fine, params={**datasets.SDOF.linear, "k3": k3},
+                                  inputs={"u": u})["y"][::over]
+    y = y + 0.003 * np.std(y[: int(stage * fs)]) * rng.standard_normal(len(y))
+    path = write_measurement(tmp_path / "data" / "run.csv", "SDOFBoucWen", t_fine[::over], {"F": (u[::over], "N", "u")},
+                             {"y": (y, "m", "y")})
+    side = path.with_suffix(".toml")
+    side.write_text(side.read_text() + "".join(
+        f"[[segments]]\nfrom_s = {k * stage}\nto_s = {(k + 1) * stage}\nlevel = \"{a:g} N\"\nlevel_value = {a}\n"
+        for k, a in enumerate((10.0, 25.0, 50.0))))
+    rep = dg.diagnose("sdof", tmp_path / "data", tmp_path / "out", fmu_dir=fmu_dir, workers=2, progress=False)
+    assert (rep["calibration_files"], rep["held_out_files"]) == (["run#1", "run#3"], ["run#2"])
+    assert rep["verdict"] == "gap explained by cubic_stiffness", rep["verdict"]
+    fitted = next(r for r in rep["ranking"] if r["effect"] == "cubic_stiffness")["params"]["k3"]
+    measured("one record of three levels cut by [[segments]] (SDOF, cubic spring drawn over a decade): fitted k3 vs "
+             "the truth, relative", abs(fitted / k3 - 1), 0.03)

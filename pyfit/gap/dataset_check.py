@@ -67,7 +67,7 @@ def check_dataset(model: str, data_dir, nominal=None, cfg: DiagnoseConfig | None
     p = prepare(model, data_dir, cfg or DiagnoseConfig(), fmu_dir, nominal, candidates)
     try:
         units = {v.name: v.unit or "" for v in p.runner.model_description.modelVariables}
-        measurements = {m.path.stem: m for m in read_dataset_with_order(data_dir)[0]}
+        measurements = {m.name: m for m in read_dataset_with_order(data_dir)[0]}
         roles = {**{r.name: "calibration" for r in p.data.cal}, **{r.name: "held out" for r in p.data.held},
                  **{name: "set aside" for name in p.data.aside}}
         noise = localise.noise_estimates(p.data.records)

@@ -111,7 +111,7 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0, smoo
     outputs = {k: without_offset(v[first:]) for k, v in m.by_variable("outputs").items()}
     # a file without a `level` label is named by its file in every table and figure
     support = motion[:2] if motion and motion[0] in derived and not spp else ()  # x integrated
-    return Record(m.path.stem, m.level or m.path.stem, float(m.level_value if m.level_value is not None else 0.0),
+    return Record(m.name, m.level or m.name, float(m.level_value if m.level_value is not None else 0.0),
                   m.sample_rate_hz, inputs, outputs, spp, weights, derived, first, support, smooth_inputs)
 
 

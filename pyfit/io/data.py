@@ -7,7 +7,8 @@ and [outputs] mapping column -> {unit, model_variable[, weight, sensitivity, inv
 column's sensor, e.g. "100 mV/g": read as what the sensor measures; invert = true: a sensor whose sign convention
 is the model's opposite, read with its sign changed);
 optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s" or "ms"), columns (the
-names of the columns of a file without a header line, in order).
+names of the columns of a file without a header line, in order), [[segments]] (a file holding several levels or
+runs: from_s, to_s and optionally level, level_value, excitation each; read as one measurement per segment).
 
 The reader takes files as lab software writes them, wherever that is still unambiguous:
 - files without a header line (a numeric export: MATLAB's `save -ascii`, a logger's raw dump) whose sidecar
@@ -43,6 +44,7 @@ import itertools
 import pathlib
 import re
 import warnings
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -66,7 +68,9 @@ MAX_TIME_SLIP = 0.25  # largest allowed distance [samples] of a time stamp from 
 SIDECAR = {"model": (str, True, None), "sample_rate_hz": ("number", False, None), "inputs": (dict, False, {}),
            "outputs": (dict, True, None), "level": (str, False, ""), "level_value": ("number", False, None),
            "excitation": (dict, False, {}), "notes": (str, False, ""), "time_column": (str, False, "t"),
-           "time_unit": (str, False, "s"), "columns": ("strings", False, None)}
+           "time_unit": (str, False, "s"), "columns": ("strings", False, None), "segments": (list, False, [])}
+SEGMENT = {"from_s": ("number", True, None), "to_s": ("number", True, None), "level": (str, False, ""),
+           "level_value": ("number", False, None), "excitation": (dict, False, {})}  # one [[segments]] table
 
 
 def unit_key(unit: str) -> str:
@@ -140,6 +144,13 @@ class Measurement:
     level_value: float | None = None
     excitation: dict = field(default_factory=dict)
     notes: str = ""
+    segment: str = ""  # which of the file's [[segments]] (1, 2, ...; "" for the whole file)
+    segments: list = field(default_factory=list)  # the sidecar's [[segments]] tables, checked (split_segments)
+
+    @property
+    def name(self) -> str:
+        """The file's stem, and '#k' for its k-th segment: how every table and figure names the record."""
+        return f"{self.path.stem}#{self.segment}" if self.segment else self.path.stem
 
     @property
     def sample_rate_hz(self) -> float:
@@ -504,8 +515,43 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
             raise MeasurementError(f"{csv_path}: row {skip + 1 + bad[0]}: column '{name}' = {v[bad[0]]:.6g} "
                                    f"{ch.unit}, beyond {MAX_ABS_SI:.0e} in SI units; allowed: magnitudes up to "
                                    f"{MAX_ABS_SI:.0e} (so that squares, sums and derivatives stay finite)")
-    return Measurement(csv_path, meta["model"], t0 + np.arange(n) / fs, inputs, outputs, values, meta["level"],
-                       meta["level_value"], dict(meta["excitation"]), meta["notes"])
+    t = t0 + np.arange(n) / fs
+    segments = [check_table(seg, side, f"segments[{i}]", SEGMENT, MeasurementError)
+                for i, seg in enumerate(meta["segments"])]
+    _check_segments(segments, t, side)
+    return Measurement(csv_path, meta["model"], t, inputs, outputs, values, meta["level"], meta["level_value"],
+                       dict(meta["excitation"]), meta["notes"], segments=segments)
+
+
+def _check_segments(segments: list[dict], t: np.ndarray, side) -> None:
+    """Each segment [from_s, to_s) within the record and two samples long at least, none overlapping another
+    (a sample in two segments could calibrate a model and judge it)."""
+    for i, seg in enumerate(segments):
+        k = int(np.sum((t >= seg["from_s"]) & (t < seg["to_s"])))
+        if not seg["from_s"] < seg["to_s"] or k < 2:
+            fail(side, f"segments[{i}]", f"from_s = {seg['from_s']:g} s to to_s = {seg['to_s']:g} s holds {k} "
+                 f"samples", f"from_s < to_s, at least two samples within the record's {t[0]:g}-{t[-1]:g} s",
+                 MeasurementError)
+    spans = sorted((seg["from_s"], seg["to_s"], i) for i, seg in enumerate(segments))
+    for (a0, a1, i), (b0, b1, j) in zip(spans, spans[1:]):
+        if b0 < a1:
+            fail(side, f"segments[{j}]", f"from_s = {b0:g} s lies inside segments[{i}] ({a0:g}-{a1:g} s)",
+                 "segments that do not overlap", MeasurementError)
+
+
+def split_segments(m: Measurement) -> list[Measurement]:
+    """A measurement as its sidecar's [[segments]] cut it (one file holding several levels or runs): each
+    segment's samples from_s <= t < to_s, its level and level_value, its excitation over the file's; the
+    measurement itself when the sidecar names no segments."""
+    if not m.segments:
+        return [m]
+    out = []
+    for k, seg in enumerate(m.segments, start=1):
+        idx = (m.t >= seg["from_s"]) & (m.t < seg["to_s"])
+        out.append(dataclasses.replace(m, t=m.t[idx], values={c: v[idx] for c, v in m.values.items()},
+                                       level=seg["level"] or m.level, level_value=seg["level_value"],
+                                       excitation={**m.excitation, **seg["excitation"]}, segment=str(k), segments=[]))
+    return out
 
 
 def _toml_value(v) -> str:
@@ -563,17 +609,17 @@ def level_order(items: list[Measurement]) -> tuple[list[Measurement], str]:
     give it), else the sidecars' excitation amplitude (the first of LEVEL_KEYS that all give), else the
     RMS of the first input (or, without inputs, of the first output)."""
     if all(m.level_value is not None for m in items):
-        return sorted(items, key=lambda m: (m.level_value, m.path.name)), "level_value"
+        return sorted(items, key=lambda m: (m.level_value, m.name)), "level_value"
     for key in LEVEL_KEYS:
         vals = [m.excitation.get(key) for m in items]
         if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
             for m, v in zip(items, vals):
                 m.level_value = float(v)
-            return sorted(items, key=lambda m: (m.level_value, m.path.name)), f"excitation.{key}"
+            return sorted(items, key=lambda m: (m.level_value, m.name)), f"excitation.{key}"
     for m in items:
         ch = next(iter(m.inputs or m.outputs))
         m.level_value = float(np.sqrt(np.mean(m.values[ch] ** 2)))
-    return sorted(items, key=lambda m: (m.level_value, m.path.name)), "input RMS"
+    return sorted(items, key=lambda m: (m.level_value, m.name)), "input RMS"
 
 
 def read_dataset(folder: str | pathlib.Path) -> list[Measurement]:
@@ -636,8 +682,9 @@ def holds_measurements(folder: pathlib.Path) -> bool:
 
 
 def read_dataset_with_order(folder: str | pathlib.Path) -> tuple[list[Measurement], str]:
-    """All measurements in a folder (measurement_files), ordered by level, and what the order rests on."""
-    items = [read_measurement(p) for p in measurement_files(folder)]
+    """All measurements in a folder (measurement_files; a file with [[segments]] as one per segment), ordered by
+    level, and what the order rests on."""
+    items = [part for p in measurement_files(folder) for part in split_segments(read_measurement(p))]
     if not items:
         raise MeasurementError(f"{folder}: no measurement found (a file ending in "
                                f"{', '.join(DATA_SUFFIXES)} beside a TOML sidecar of its stem)")
@@ -646,4 +693,4 @@ def read_dataset_with_order(folder: str | pathlib.Path) -> tuple[list[Measuremen
 
 __all__ = ["Channel", "DATA_SUFFIXES", "Measurement", "MeasurementError", "QUANTITY", "TO_SI", "check_quantities",
            "holds_measurements", "level_order", "measurement_files", "read_dataset", "read_dataset_with_order",
-           "read_measurement", "unit_key", "write_measurement"]
+           "read_measurement", "split_segments", "unit_key", "write_measurement"]
