@@ -58,7 +58,8 @@ def test_default_nominal_damper_keeps_the_design_eccentric_masses():
     ('[nominal]\nfamily = "beam"\n', r"\[nominal.family\] unknown family 'beam'; allowed: sdof, damper"),
     ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = "heavy"\n',
      r"\[nominal.fixed.m1\] 'heavy': not a number followed by a unit; allowed: a number in SI units, or a string"),
-    ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = "1.2 kilo"\n', r"\[nominal.fixed.m1\] '1.2 kilo': unknown unit"),
+    ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = "1.2 kilo"\n',
+     r"\[nominal.fixed.m1\] '1.2 kilo': unknown unit"),
     ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = true\n', r"\[nominal.fixed.m1\] must be a number \(SI\) or"),
     # a unit slip: millimetres, grams, kg·mm² written as SI numbers, and a unit of another quantity
     ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nL1 = 150\n',
@@ -67,9 +68,11 @@ def test_default_nominal_damper_keeps_the_design_eccentric_masses():
      r"\[nominal.free.EI.start\] 1.2e\+07 N.m2 is not what a Stockbridge damper has"),
     ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = 1200\n', r"\[nominal.fixed.m1\] 1200 kg is not what"),
     ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nm1 = 1.0\nJ_G1 = 2.0\n',
-     r"\[nominal.fixed.J_G1\] J_G1 / m1 gives a radius of gyration of 1.41e\+03 mm, not a damper mass's \(3 to 500 mm\)"),
+     r"\[nominal.fixed.J_G1\] J_G1 / m1 gives a radius of gyration of 1.41e\+03 mm, not a damper mass's "
+     r"\(3 to 500 mm\)"),
     ('[nominal]\nfamily = "damper"\n[nominal.fixed]\nL1 = "150 g"\n',
-     r"\[nominal.fixed.L1\] 'g' is a mass \(kg\), but L1 is in m; allowed: a number in m or a value in a unit of a length"),
+     r"\[nominal.fixed.L1\] 'g' is a mass \(kg\), but L1 is in m; allowed: a number in m or a value in a unit "
+     r"of a length"),
     ('[nominal]\nfamily = "damper"\n[nominal.free]\nEI = { start = "12 N.m2", lower = "4 N.m", upper = 40.0 }\n',
      r"\[nominal.free.EI.lower\] 'N.m' is kg.m2/s2, but nominal.free.EI.start is in 'N.m2'"),
     ('[nominal]\nfamily = "damper"\n[nominal.free]\nEI = { start = 50.0, lower = 1.0, upper = 30.0 }\n',
@@ -121,7 +124,8 @@ def test_unknown_parameter_names_the_valid_ones(tmp_path, fmu_dir):
 
     f = tmp_path / "n.toml"
     f.write_text('[nominal]\nfamily = "damper"\n[nominal.fixed]\nmass1 = 1.0\n')
-    with pytest.raises(ConfigError, match=r"n.toml: \[nominal.fixed.mass1\] not a parameter of the model; allowed: A, D, EI, "):
+    with pytest.raises(ConfigError, match=r"n.toml: \[nominal.fixed.mass1\] not a parameter of the model; "
+                                          r"allowed: A, D, EI, "):
         load_nominal(f).check_against(FmuRunner(str(fmu_dir / "StockbridgeDamper.fmu")).parameters())
 
 

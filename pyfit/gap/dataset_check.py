@@ -83,9 +83,10 @@ def check_dataset(model: str, data_dir, nominal=None, cfg: DiagnoseConfig | None
                     channels.append(ChannelCheck(col, side, unit, ch.model_variable, units.get(ch.model_variable, ""),
                                                  float(np.sqrt(np.mean((v - np.mean(v)) ** 2))), ch.invert))
             rec = records.get(name)
-            files.append(FileCheck(name, m.level, float(m.level_value), float(m.t[-1] - m.t[0] + 1 / m.sample_rate_hz),
-                                   roles.get(name, "set aside"), localise.excited_band(rec) if rec else None,
-                                   noise[name][0] if rec else None, noise[name][1] if rec else "", channels))
+            length = float(m.t[-1] - m.t[0] + 1 / m.sample_rate_hz)
+            files.append(FileCheck(name, m.level, float(m.level_value), length, roles.get(name, "set aside"),
+                                   localise.excited_band(rec) if rec else None, noise[name][0] if rec else None,
+                                   noise[name][1] if rec else "", channels))
         named = p.described.parameters() if p.described else {}
         return DatasetCheck(str(data_dir), model, pathlib.Path(p.fmu).name, p.data.order, p.data.rate.file_hz,
                             p.data.rate.hz, files, p.band, [m.f_n for m in p.modes], named, p.data.voltages)
@@ -100,10 +101,11 @@ def _per(unit: str) -> float:
 
 def check_text(c: DatasetCheck) -> str:
     """The check as Markdown: the files, their channels, the split, the noise floor, the band and resonances."""
+    resonances = ", ".join(f"{f:.3g}" for f in c.resonances_hz) or "none"
     lines = [f"# Dataset check: {c.folder} ({c.model}, {c.fmu})", "",
              f"{len(c.files)} files, levels ordered by {c.level_order}; sampled at {c.file_hz:g} Hz, analysed at "
              f"{c.analysis_hz:g} Hz. Excited band {c.excited_hz[0]:.3g}-{c.excited_hz[1]:.3g} Hz; the nominal "
-             f"model's resonances (at its start values): {', '.join(f'{f:.3g}' for f in c.resonances_hz) or 'none'} Hz.", "",
+             f"model's resonances (at its start values): {resonances} Hz.", "",
              "| file | level | length [s] | role | excited [Hz] | noise floor (NRMSE) |", "|---|---|---|---|---|---|"]
     for f in c.files:
         band = f"{f.excited_hz[0]:.3g}-{f.excited_hz[1]:.3g}" if f.excited_hz else "—"

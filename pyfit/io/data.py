@@ -44,8 +44,7 @@ import itertools
 import pathlib
 import re
 import warnings
-import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -548,9 +547,9 @@ def split_segments(m: Measurement) -> list[Measurement]:
     out = []
     for k, seg in enumerate(m.segments, start=1):
         idx = (m.t >= seg["from_s"]) & (m.t < seg["to_s"])
-        out.append(dataclasses.replace(m, t=m.t[idx], values={c: v[idx] for c, v in m.values.items()},
-                                       level=seg["level"] or m.level, level_value=seg["level_value"],
-                                       excitation={**m.excitation, **seg["excitation"]}, segment=str(k), segments=[]))
+        out.append(replace(m, t=m.t[idx], values={c: v[idx] for c, v in m.values.items()},
+                           level=seg["level"] or m.level, level_value=seg["level_value"],
+                           excitation={**m.excitation, **seg["excitation"]}, segment=str(k), segments=[]))
     return out
 
 

@@ -147,20 +147,20 @@ def _check_dimension(path, key: str, unit: Unit, name: str, declared: str | None
 
 def _check_plausible(path, family: str, fixed: dict, free: dict, units: dict) -> None:
     """Refuse a described value (known, or an uncertain one's start) outside what the family's device can have."""
-    given = {**{n: ("fixed", v) for n, v in fixed.items()},
-             **{n: ("free", p.start) for n, p in free.items() if p.start is not None}}
+    given = {**{n: (f"nominal.fixed.{n}", v) for n, v in fixed.items()},
+             **{n: (f"nominal.free.{n}.start", p.start) for n, p in free.items() if p.start is not None}}
     hint = "the file's numbers are SI (kg, m, kg·m², N·m²); write another unit with the number, e.g. \"150 mm\""
     for name, (lo, hi, si_unit) in PLAUSIBLE.get(family, {}).items():
         if name in units:
             _check_dimension(path, *units[name], name, si_unit)
         if name in given and not lo <= given[name][1] <= hi:
-            section, value = given[name]
-            fail(path, f"nominal.{section}.{name}" + (".start" if section == "free" else ""),
-                 f"{value:g} {si_unit} is not what a Stockbridge damper has ({lo:g} to {hi:g} {si_unit}); {hint}")
+            key, value = given[name]
+            fail(path, key, f"{value:g} {si_unit} is not what a Stockbridge damper has ({lo:g} to {hi:g} {si_unit}); "
+                 f"{hint}")
     for i in (1, 2):
         if family == "damper" and f"J_G{i}" in given and f"m{i}" in given:
             r = (given[f"J_G{i}"][1] / given[f"m{i}"][1]) ** 0.5
             if not RADIUS_OF_GYRATION[0] <= r <= RADIUS_OF_GYRATION[1]:
-                fail(path, f"nominal.{given[f'J_G{i}'][0]}.J_G{i}", f"J_G{i} / m{i} gives a radius of gyration of "
+                fail(path, given[f"J_G{i}"][0], f"J_G{i} / m{i} gives a radius of gyration of "
                      f"{1e3 * r:.3g} mm, not a damper mass's ({1e3 * RADIUS_OF_GYRATION[0]:g} to "
                      f"{1e3 * RADIUS_OF_GYRATION[1]:g} mm); {hint}")
