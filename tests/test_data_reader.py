@@ -56,9 +56,10 @@ def test_absent_time_column_uses_the_sidecar_rate(tmp_path):
     assert m.t[0] == 0.0 and m.t[-1] == pytest.approx((N - 1) / FS, rel=1e-14)
 
 
-def test_time_in_ms_with_offset_start(tmp_path):
+@pytest.mark.parametrize("time_unit", ["ms", "msec"])
+def test_time_in_ms_with_offset_start(tmp_path, time_unit):
     t = 12.5 + np.arange(N) / FS  # a segment cut from a long record, stamped in ms with 7 digits
-    m = read_measurement(lab_file(tmp_path, time_fmt="%.7g", t=t * 1e3, sidecar_extra='time_unit = "ms"'))
+    m = read_measurement(lab_file(tmp_path, time_fmt="%.7g", t=t * 1e3, sidecar_extra=f'time_unit = "{time_unit}"'))
     assert m.t[0] == pytest.approx(12.5, abs=1e-6)
     assert np.max(np.abs(np.diff(m.t) - 1 / FS)) < 1e-12
 
@@ -264,7 +265,9 @@ def test_lab_export_variants_are_read(tmp_path, header, rows, unit_x):
 
 
 @pytest.mark.parametrize("unit, si", [("m/s^2", 1.0), ("m/s²", 1.0), ("mm/s^2", 1e-3), ("µm", 1e-6), ("μm", 1e-6),
-                                      ("[m/s]", 1.0)])
+                                      ("[m/s]", 1.0), ("m/s/s", 1.0), ("m s^-2", 1.0), ("m·s⁻²", 1.0),
+                                      ("mm/sec", 1e-3), ("m/sec^2", 1.0), ("G", 9.80665), ("gn", 9.80665),
+                                      ("ips", 0.0254), ("in/s²", 0.0254)])
 def test_unit_spellings(tmp_path, unit, si):
     m = read_measurement(_export(tmp_path, '"Time, s",x,F', ROWS, unit))
     assert m.values["x"][2] == pytest.approx(1.0 * si, rel=1e-15)

@@ -39,8 +39,10 @@ or non-finite values in a used column.
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import itertools
+import math
 import pathlib
 import re
 import warnings
@@ -49,6 +51,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from pyfit.io.schema import ConfigError, check_table, fail, read_text, read_toml
+from pyfit.io.units import parse_unit
 
 G0 = 9.80665  # standard gravity [m/s2], exact by definition
 INCH, FOOT, POUND = 0.0254, 0.3048, 0.45359237  # [m], [m], [kg]: exact by the 1959 international agreement
@@ -72,13 +75,43 @@ SEGMENT = {"from_s": ("number", True, None), "to_s": ("number", True, None), "le
            "level_value": ("number", False, None), "excitation": (dict, False, {})}  # one [[segments]] table
 
 
+ALIASES = {"G": "g", "gn": "g", "ips": "in/s"}  # spellings DAQ software and US reports use for units of TO_SI
+_SECONDS = re.compile(r"(?<![A-Za-z])(m?)sec(?![A-Za-z])")  # 'sec', 'msec' as in 'm/sec', 'Time [msec]'
+
+
 def unit_key(unit: str) -> str:
-    """A unit as TO_SI spells it: brackets and spaces dropped, '^2', '**2' and '²' as '2', 'µ'/'μ' as 'u'
-    ('[m/s^2]' -> 'm/s2'); an unknown unit is returned as it is (after the same clean-up)."""
-    u = unit.strip().strip("[]()").replace(" ", "")
+    """A unit as TO_SI (or TIME_UNITS) spells it: brackets and spaces dropped, '^2', '**2' and '²' as '2',
+    'µ'/'μ' as 'u', 'sec' as 's', ALIASES ('[m/s^2]' -> 'm/s2', 'm/sec' -> 'm/s', 'G' -> 'g'); a unit of the same
+    quantity and size as one of TO_SI written another way ('m/s/s', 'm s^-2', 'm·s⁻²': pyfit.io.units) as that
+    one; an unknown unit is returned as it is (after the same clean-up)."""
+    spaced = _SECONDS.sub(r"\1s", unit.strip().strip("[]()").strip())
+    u = spaced.replace(" ", "")
     for a, b in (("**2", "2"), ("^2", "2"), ("²", "2"), ("µ", "u"), ("μ", "u")):
         u = u.replace(a, b)
-    return u
+    u = ALIASES.get(u, u)
+    return u if u in TO_SI or u in TIME_UNITS else _same_as(spaced) or u
+
+
+_DIMENSION = {"length": (0, 1, 0, 0), "velocity": (0, 1, -1, 0), "acceleration": (0, 1, -2, 0),
+              "force": (1, 1, -2, 0), "voltage": (1, 2, -3, -1), "angle": (0, 0, 0, 0)}  # of QUANTITY's names
+
+
+@functools.lru_cache(maxsize=None)
+def _same_as(text: str) -> str | None:
+    """The key of TO_SI whose quantity and size `text` has (pyfit.io.units grammar), or None."""
+    try:
+        wanted = parse_unit(text)
+    except ValueError:
+        return None
+    for key in TO_SI:
+        try:
+            unit = parse_unit(key)
+        except ValueError:
+            continue
+        if unit.dimension == _DIMENSION[QUANTITY[key]] == wanted.dimension and \
+                math.isclose(unit.factor, wanted.factor, rel_tol=1e-12):
+            return key
+    return None
 
 
 class MeasurementError(ConfigError):
@@ -482,6 +515,7 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
     fs = meta["sample_rate_hz"]
     if fs is not None and not fs > 0:
         fail(side, "sample_rate_hz", f"{fs} is not > 0", error=MeasurementError)
+    meta["time_unit"] = unit_key(meta["time_unit"])  # 'sec', 'msec' as DAQ exports write them
     if meta["time_unit"] not in TIME_UNITS:
         fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join(TIME_UNITS), MeasurementError)
     inputs = _channels(side, meta["inputs"], "inputs")
