@@ -155,3 +155,33 @@ def test_a_faster_file_on_its_coarser_grid_meets_the_closed_form_as_well(runner,
     measured(f"linear oscillator forced at 35 Hz, {'spline' if smooth else 'lines'}: NRMSE against the closed form "
              f"of a {2 * REFERENCE_HZ:g} Hz file on {grid} grid point(s) per sample over a {REFERENCE_HZ:g} Hz "
              f"file's on {upsample}", fast / slow, 1.0)
+
+
+def test_a_level_recorded_faster_is_brought_to_the_dataset_s_rate(tmp_path, sdof_system):
+    """Three levels of a linear SDOF's response to a 5-80 Hz sweep (scipy lsim at 1 kHz, independent of the FMU),
+    the middle one written at 1 kHz and the others at every second sample (500 Hz): the 1 kHz file is decimated to
+    500 Hz after the anti-alias filter (80 Hz lies in its flat passband, within 1e-4: its own 500 Hz samples
+    are met to that), the report names it; a rate that is no whole multiple of the slowest is refused."""
+    import scipy.signal
+
+    from pyfit.gap.report import _rate_lines
+
+    runner, system = sdof_system
+    t = np.arange(6000) / 1000.0
+    u = np.sin(2 * np.pi * (5.0 + 6.25 * t) * t)
+    _, y, _ = scipy.signal.lsim(([1.0 / 2.0], [1.0, 5.0, 5e4]), u, t)
+    for level, step in ((10.0, 2), (25.0, 1), (50.0, 2)):
+        write_measurement(tmp_path / f"L{level:g}.csv", "SDOFBoucWen", t[::step], {"F": (level * u[::step], "N", "u")},
+                          {"y": (level * y[::step], "m", "y")}, level_value=level)
+    data = dg._load(tmp_path, system, dg.DiagnoseConfig(), runner)
+    assert data.rate.file_hz == pytest.approx(500.0) and data.recorded_hz == {"L25": pytest.approx(1000.0)}
+    held = data.held[0]
+    assert held.name == "L25" and held.fs == pytest.approx(500.0)
+    want = 25.0 * y[::2][: len(held.outputs["y"])]
+    assert np.max(np.abs(held.outputs["y"] - (want - np.mean(want)))) < 1e-4 * np.max(np.abs(want))
+    assert "L25 (1000 Hz, decimated by 2)" in "".join(_rate_lines({"file_hz": 500.0, "recorded_hz": data.recorded_hz}))
+    write_measurement(tmp_path / "L25.csv", "SDOFBoucWen", t[::4] * 4 / 3, {"F": (25.0 * u[::4], "N", "u")},
+                      {"y": (25.0 * y[::4], "m", "y")}, level_value=25.0)  # 187.5 Hz: 500 Hz is no whole multiple
+    with pytest.raises(dg.DiagnoseError, match=r"L10.toml: sample_rate_hz = 500 but L25.csv has 187.5; allowed: one "
+                                               r"rate, or rates that are whole multiples of the slowest"):
+        dg._load(tmp_path, system, dg.DiagnoseConfig(), runner)

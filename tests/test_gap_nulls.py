@@ -50,11 +50,11 @@ def test_bad_input_gives_one_clear_error(data_root, tmp_path, fmu_dir):
     with pytest.raises(dg.DiagnoseError, match=r"level2_25N\.toml"):
         dg.diagnose("sdof", one, tmp_path / "o2", CI, fmu_dir)
     side = (src / "level2_25N.toml").read_text()
-    (one / "level2_25N.toml").write_text(side.replace("sample_rate_hz = 500", "sample_rate_hz = 250"))
+    (one / "level2_25N.toml").write_text(side.replace("sample_rate_hz = 500", "sample_rate_hz = 300"))
     csv = np.loadtxt(src / "level2_25N.csv", delimiter=",", skiprows=1)
-    csv[:, 0] *= 2.0
+    csv[:, 0] *= 5.0 / 3.0  # 300 Hz: 500 Hz is no whole multiple of it (a whole multiple is decimated to it)
     np.savetxt(one / "level2_25N.csv", csv, delimiter=",", header="t,u_meas,y_meas", comments="", fmt="%.15g")
-    with pytest.raises(dg.DiagnoseError, match="sample_rate_hz = 250 but level1_10N.csv has 500"):
+    with pytest.raises(dg.DiagnoseError, match="level1_10N.toml: sample_rate_hz = 500 but level2_25N.csv has 300"):
         dg.diagnose("sdof", one, tmp_path / "o3", CI, fmu_dir)
     with pytest.raises(dg.DiagnoseError, match="'friction' unknown for sdof; allowed: hysteresis"):
         dg.diagnose("sdof", src, tmp_path / "o4", dg.DiagnoseConfig(effects=["friction"]), fmu_dir)

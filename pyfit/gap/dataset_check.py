@@ -58,6 +58,7 @@ class DatasetCheck:
     resonances_hz: list[float]  # the nominal start's linear modes
     nominal: dict[str, float]  # the described values (SI) over the FMU's defaults, of the parameters named
     voltage_channels: list[str]
+    recorded_hz: dict[str, float]  # files recorded faster than the dataset's rate, decimated to it: name -> Hz
 
 
 def check_dataset(model: str, data_dir, nominal=None, cfg: DiagnoseConfig | None = None, fmu_dir="fmus",
@@ -89,7 +90,8 @@ def check_dataset(model: str, data_dir, nominal=None, cfg: DiagnoseConfig | None
                                    noise[name][1] if rec else "", channels))
         named = p.described.parameters() if p.described else {}
         return DatasetCheck(str(data_dir), model, pathlib.Path(p.fmu).name, p.data.order, p.data.rate.file_hz,
-                            p.data.rate.hz, files, p.band, [m.f_n for m in p.modes], named, p.data.voltages)
+                            p.data.rate.hz, files, p.band, [m.f_n for m in p.modes], named, p.data.voltages,
+                            p.data.recorded_hz)
     finally:
         p.runner.close()
 
@@ -119,6 +121,9 @@ def check_text(c: DatasetCheck) -> str:
             sign = "inverted" if ch.inverted else "as recorded"
             lines.append(f"| {f.name} | {ch.column} | {ch.side} | {ch.unit} | {ch.model_variable} "
                          f"[{ch.model_unit or '—'}] | {ch.rms_si:.4g} | {sign} |")
+    if c.recorded_hz:
+        lines += ["", f"Recorded faster and decimated to the dataset's {c.file_hz:g} Hz: "
+                  + ", ".join(f"{name} ({hz:g} Hz)" for name, hz in c.recorded_hz.items()) + "."]
     if c.voltage_channels:
         lines += ["", "Recorded as voltages with an unknown gain (every parameter the model fits carries it): "
                   + ", ".join(c.voltage_channels) + "."]

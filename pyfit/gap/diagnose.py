@@ -24,7 +24,7 @@ from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read
 from pyfit.gap import band, confidence, localise, polarity, selection, user_candidates
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, nominal_task, pinned, run_fit, screen
-from pyfit.gap.rate import AnalysisRate, analysis_rate, at_rate, drive_upsample
+from pyfit.gap.rate import AnalysisRate, analysis_rate, at_rate, common_rate, drive_upsample
 from pyfit.gap.systems import System, combine, family_fmu, make_system, strength_grid
 from pyfit.io.nominal import NominalModel, load_nominal
 
@@ -104,6 +104,8 @@ class Dataset:
     aside: dict  # records the default split set aside (localise.unsettled: name -> period scatter, lower floor)
     voltages: list  # 'column (model_variable)' of each channel recorded as a voltage (System.gains_free)
     rate: AnalysisRate  # the rate the records are analysed at (the files' or decimated: pyfit.gap.rate)
+    recorded_hz: dict  # name -> the rate a file was recorded at, where it was faster than the dataset's
+    # (rate.common_rate: decimated to the slowest file's rate)
 
 
 def default_calibration(records: list) -> list:
@@ -141,13 +143,14 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
         if m.model != system.fmu:
             raise DiagnoseError(f"{m.path.with_suffix('.toml')}: model = '{m.model}' but --model {system.name} "
                                 f"expects '{system.fmu}'")
-        if abs(m.sample_rate_hz - ms[0].sample_rate_hz) > 1e-6 * ms[0].sample_rate_hz:
-            raise DiagnoseError(f"{m.path.with_suffix('.toml')}: sample_rate_hz = {m.sample_rate_hz:g} but "
-                                f"{ms[0].path.name} has {ms[0].sample_rate_hz:g}; a dataset needs one rate")
         try:
             voltages.update(check_quantities(m, units, system.gains_free))
         except MeasurementError as exc:
             raise DiagnoseError(str(exc)) from exc
+    try:
+        ms, recorded_hz = common_rate(ms)
+    except ValueError as exc:
+        raise DiagnoseError(str(exc)) from exc
     rate = analysis_rate(ms)
     ms = [at_rate(m, rate.factor) for m in ms]
     unknown = [e for e in (cfg.effects or []) if e not in system.effects]
@@ -187,7 +190,7 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
     for m in ms:
         digest.update(m.path.read_bytes())
         digest.update(m.path.with_suffix(".toml").read_bytes())
-    return Dataset(records, cal, held, digest.hexdigest()[:16], order, aside, sorted(voltages), rate)
+    return Dataset(records, cal, held, digest.hexdigest()[:16], order, aside, sorted(voltages), rate, recorded_hz)
 
 
 def _simulated(runner, records, values: dict, system, cfg: DiagnoseConfig) -> dict:
@@ -926,7 +929,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     result["level_order"] = data.order
     result["set_aside"] = {name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in data.aside.items()}
     result["voltage_channels"] = data.voltages
-    result["analysis_rate"] = {**asdict(data.rate), "drive_upsample": cfg.upsample}
+    result["analysis_rate"] = {**asdict(data.rate), "drive_upsample": cfg.upsample, "recorded_hz": data.recorded_hz}
     top = result["ranking"][0]["shrink_pct"] if result["ranking"] else None
     calibration = confidence.load(confidence.settings_of(asdict(requested)), model)  # of the settings asked for
     result["confidence"] = confidence.stated(result["verdict"], result["chosen_effect"], top, calibration)

@@ -89,6 +89,26 @@ def at_rate(m: Measurement, q: int) -> Measurement:
     return replace(m, t=t, values=values, excitation=excitation)
 
 
+def common_rate(ms: list[Measurement]) -> tuple[list[Measurement], dict[str, float]]:
+    """A dataset's files at one rate: a file recorded at a whole multiple of the slowest file's rate (a level the
+    DAQ sampled faster) decimated to it after the zero-phase anti-alias filter (at_rate). Returns the files and
+    the rate [Hz] each decimated one was recorded at, by name. ValueError naming the first file whose rate is no
+    whole multiple of the slowest (or whose period a multisine's decimation would not keep whole)."""
+    slowest = min(ms, key=lambda m: m.sample_rate_hz)
+    fs = slowest.sample_rate_hz
+    out, recorded = [], {}
+    for m in ms:
+        q = round(m.sample_rate_hz / fs)
+        if abs(m.sample_rate_hz - q * fs) > 1e-6 * m.sample_rate_hz or m.samples_per_period % q:
+            raise ValueError(f"{m.path.with_suffix('.toml')}: sample_rate_hz = {m.sample_rate_hz:g} but "
+                             f"{slowest.path.name} has {fs:g}; allowed: one rate, or rates that are whole multiples "
+                             "of the slowest file's (a multisine's samples per period too), decimated to it")
+        if q > 1:
+            recorded[m.name] = m.sample_rate_hz
+        out.append(at_rate(m, q))
+    return out, recorded
+
+
 def drive_upsample(upsample: int, rate: AnalysisRate) -> int:
     """The FMU's drive grid as a multiple of the analysis rate, for a family that drives files at REFERENCE_HZ
     with `upsample`: the least whole number whose grid has at least `upsample` points per sample of REFERENCE_HZ

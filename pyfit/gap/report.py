@@ -474,17 +474,22 @@ def _voltage_lines(channels: list[str]) -> list[str]:
 
 
 def _rate_lines(rate: dict | None) -> list[str]:
-    """The rate the records were analysed at and the FMU's drive grid, for files faster than the rate the families'
-    drive grids were set at (pyfit.gap.rate)."""
+    """The files brought to the dataset's rate (pyfit.gap.rate.common_rate), and the rate the records were analysed
+    at and the FMU's drive grid, for files faster than the rate the families' drive grids were set at."""
+    faster = [f"{name} ({hz:.6g} Hz, decimated by {round(hz / rate['file_hz'])})"
+              for name, hz in (rate or {}).get("recorded_hz", {}).items()]
+    common = ([f"Files recorded faster than the dataset's {rate['file_hz']:.6g} Hz brought to it after a zero-phase "
+               f"anti-alias filter: {', '.join(faster)}.", ""] if faster else [])
     if not rate or rate["file_hz"] <= REFERENCE_HZ:
-        return []
+        return common
     hz = rate["file_hz"] / rate["factor"]
     drive = f"the FMU driven on a {hz * rate['drive_upsample']:.6g} Hz grid ({rate['drive_upsample']} per sample)"
     if rate["factor"] == 1:
-        return [f"Analysed at the files' {hz:.6g} Hz, {drive}; the inputs excite up to {rate['top_hz']:.1f} Hz.", ""]
-    return [f"Analysed at {hz:.6g} Hz: the files' {rate['file_hz']:.6g} Hz decimated by {rate['factor']} after a "
-            f"zero-phase anti-alias filter (the inputs excite up to {rate['top_hz']:.1f} Hz; the rate kept is at least "
-            f"{rate['min_ratio']:g} times that), {drive}.", ""]
+        return common + [f"Analysed at the files' {hz:.6g} Hz, {drive}; the inputs excite up to "
+                         f"{rate['top_hz']:.1f} Hz.", ""]
+    return common + [f"Analysed at {hz:.6g} Hz: the files' {rate['file_hz']:.6g} Hz decimated by {rate['factor']} "
+                     f"after a zero-phase anti-alias filter (the inputs excite up to {rate['top_hz']:.1f} Hz; the rate "
+                     f"kept is at least {rate['min_ratio']:g} times that), {drive}.", ""]
 
 
 def markdown(result: dict) -> str:
