@@ -537,3 +537,32 @@ def test_segments_that_cannot_be_cut_are_refused_naming_the_table(tmp_path, segm
     side.write_text(side.read_text() + segments)
     with pytest.raises(MeasurementError, match=says):
         read_measurement(path)
+
+
+@pytest.mark.parametrize("stamp", ["%Y-%m-%d %H:%M:%S.%f", "%Y-%m-%dT%H:%M:%S.%f", "%H:%M:%S.%f"])
+def test_a_time_column_of_clock_stamps_reads_as_seconds_from_the_first(tmp_path, stamp):
+    """A DAQ that stamps each sample with the wall clock (a date and time, or the time of day, to the µs): the
+    record's time runs from its first stamp, the rate comes from the stamps when the sidecar gives none, and
+    the stamps must meet it as numeric ones do."""
+    import datetime
+
+    start = datetime.datetime(2026, 5, 4, 10, 15, 32, 125000)
+    n = 3000
+    rows = [f"{(start + datetime.timedelta(seconds=k / FS)).strftime(stamp)},{np.sin(k / 7):.8f},{np.cos(k / 5):.8f}"
+            for k in range(n)]
+    path = tmp_path / "run.csv"
+    path.write_text("Time,x_mm,F_kN\n" + "\n".join(rows) + "\n")
+    path.with_suffix(".toml").write_text('model = "SDOFBoucWen"\ntime_column = "Time"\ntime_unit = "clock"\n'
+                                         '[inputs]\nF_kN = { unit = "kN", model_variable = "u" }\n'
+                                         '[outputs]\nx_mm = { unit = "mm", model_variable = "y" }\n')
+    m = read_measurement(path)
+    assert m.sample_rate_hz == pytest.approx(FS, rel=1e-9) and np.max(np.abs(m.t - np.arange(n) / FS)) < 1e-6
+    assert m.values["x_mm"][7] == pytest.approx(1e-3 * np.sin(1.0), abs=1e-11)
+    path.write_text(path.read_text().replace(rows[10].split(",")[0], "12.5", 1))
+    with pytest.raises(MeasurementError, match=r"run.csv: not numeric in a used column .*'12.5'.* at row 10.*and "
+                                               r"clock times \(YYYY-MM-DD hh:mm:ss.fff or hh:mm:ss.fff\) in 'Time'"):
+        read_measurement(path)
+    side = path.with_suffix(".toml")
+    side.write_text(side.read_text().replace('time_unit = "clock"\n', ""))
+    with pytest.raises(MeasurementError, match=r'a time column of clock times: time_unit = "clock"'):
+        read_measurement(path)

@@ -6,7 +6,8 @@ Sidecar keys: model, sample_rate_hz (optional where the file has a time column: 
 and [outputs] mapping column -> {unit, model_variable[, weight, sensitivity, invert]} (sensitivity: a voltage
 column's sensor, e.g. "100 mV/g": read as what the sensor measures; invert = true: a sensor whose sign convention
 is the model's opposite, read with its sign changed);
-optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s" or "ms"), columns (the
+optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s", "ms" or "clock":
+wall-clock stamps, the record's time counted from its first), columns (the
 names of the columns of a file without a header line, in order), [[segments]] (a file holding several levels or
 runs: from_s, to_s and optionally level, level_value, excitation each; read as one measurement per segment).
 
@@ -64,6 +65,7 @@ QUANTITY = {**{u: "length" for u in ("m", "cm", "mm", "um", "in", "ft")}, "rad":
             **{u: "acceleration" for u in ("m/s2", "cm/s2", "mm/s2", "in/s2", "ft/s2", "g", "mg")},
             **{u: "force" for u in ("N", "mN", "daN", "kN", "lbf")}, "V": "voltage", "mV": "voltage"}  # of TO_SI
 TIME_UNITS = {"s": 1.0, "ms": 1e-3}
+CLOCK = "clock"  # time_unit of a time column of wall-clock stamps (clock_seconds): the record's time from its first
 MAX_ABS_SI = 1e100  # largest magnitude of a measured value in SI units: its square over a million samples,
 #                      and its derivatives at MHz rates, stay far inside double precision (1.8e308)
 MAX_TIME_SLIP = 0.25  # largest allowed distance [samples] of a time stamp from the uniform grid
@@ -353,19 +355,38 @@ def _unnamed(csv_path: pathlib.Path, line: str, row: int, columns: list[str], ab
     return _Header(list(columns), row - 1, delimiter, {})
 
 
-def _load_columns(csv_path, text: str, head: _Header, wanted: list[str]) -> dict[str, np.ndarray]:
+def clock_seconds(field: str) -> float:
+    """A wall-clock time stamp as seconds: an ISO 8601 date and time ('2026-05-04 10:15:32.123456', a 'T' or a
+    space between) since 1970, or a time of day ('10:15:32.125') since midnight. ValueError otherwise."""
+    text = field.strip().strip('"').strip()
+    if re.fullmatch(r"\d{4}-\d\d-\d\d[T ]\d\d:\d\d:\d\d(\.\d+)?", text):
+        stamp = np.datetime64(text.replace(" ", "T"), "ns")
+        return float((stamp - np.datetime64("1970-01-01T00:00:00", "ns")) / np.timedelta64(1, "ns")) * 1e-9
+    match = re.fullmatch(r"(\d{1,2}):(\d\d):(\d\d(?:\.\d+)?)", text)
+    if not match:
+        raise ValueError(f"'{field}' is not a clock time (YYYY-MM-DD hh:mm:ss.fff or hh:mm:ss.fff)")
+    return 3600 * int(match.group(1)) + 60 * int(match.group(2)) + float(match.group(3))
+
+
+def _load_columns(csv_path, text: str, head: _Header, wanted: list[str], clock: str | None = None
+                  ) -> dict[str, np.ndarray]:
+    """The `wanted` columns as floats; the column `clock` (a time column of wall-clock stamps) as clock_seconds."""
     idx = [head.names.index(w) for w in wanted]
+    converters = {head.names.index(clock): clock_seconds} if clock else None
     try:
         with warnings.catch_warnings():  # an empty body is refused below, with the file named
             warnings.simplefilter("ignore", UserWarning)
             data = np.loadtxt(_lines(_decimal_point(text, head.delimiter)),
                               delimiter=None if head.delimiter == SPACES else head.delimiter,
-                              skiprows=head.skip, usecols=idx, ndmin=2, comments="#", quotechar='"')
+                              skiprows=head.skip, usecols=idx, ndmin=2, comments="#", quotechar='"',
+                              converters=converters)
     except ValueError as exc:
         mark = ("'.' as the decimal mark" if head.delimiter == ","
                 else "'.' or ',' as the decimal mark, no digit grouping")
+        clocks = (f", and clock times (YYYY-MM-DD hh:mm:ss.fff or hh:mm:ss.fff) in '{clock}'" if clock else
+                  " (a time column of clock times: time_unit = \"clock\")")
         raise MeasurementError(f"{csv_path}: not numeric in a used column ({', '.join(wanted)}): {exc}; "
-                               f"allowed: numbers with {mark}") from exc
+                               f"allowed: numbers with {mark}{clocks}") from exc
     if data.shape[0] == 0:
         raise MeasurementError(f"{csv_path}: no data rows after row {head.skip}; allowed: at least two samples")
     return dict(zip(wanted, data.T))
@@ -449,7 +470,9 @@ def _text_columns(csv_path: pathlib.Path, side: pathlib.Path, meta: dict, channe
         raise MeasurementError(f"{csv_path}: row {skip}: the units row gives '{head.units[time_col]}' for the time "
                                f"column '{time_col}' but {side.name} says time_unit = '{meta['time_unit']}'; "
                                "allowed: the same unit in both")
-    return _load_columns(csv_path, text, head, ([time_col] if time_col else []) + list(channels)), time_col, skip
+    clock = time_col if meta["time_unit"] == CLOCK else None
+    return (_load_columns(csv_path, text, head, ([time_col] if time_col else []) + list(channels), clock), time_col,
+            skip)
 
 
 MAT_ALLOWED = ("a MATLAB file of format v4 to v7.2 (MATLAB's default; save(..., '-v7') for a v7.3 file) holding "
@@ -463,6 +486,9 @@ def _mat_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: d
     matches the sidecar's `columns`, by those names."""
     import scipy.io
 
+    if meta["time_unit"] == CLOCK:
+        fail(side, "time_unit", f"'{CLOCK}' for {path.name}: clock stamps are text", "s or ms for a MATLAB file's "
+             "time vector", MeasurementError)
     try:
         raw = scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False)
     except NotImplementedError as exc:  # scipy's answer to a v7.3 (HDF5) file
@@ -516,8 +542,8 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
     if fs is not None and not fs > 0:
         fail(side, "sample_rate_hz", f"{fs} is not > 0", error=MeasurementError)
     meta["time_unit"] = unit_key(meta["time_unit"])  # 'sec', 'msec' as DAQ exports write them
-    if meta["time_unit"] not in TIME_UNITS:
-        fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join(TIME_UNITS), MeasurementError)
+    if meta["time_unit"] not in (*TIME_UNITS, CLOCK):
+        fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join((*TIME_UNITS, CLOCK)), MeasurementError)
     inputs = _channels(side, meta["inputs"], "inputs")
     outputs = _channels(side, meta["outputs"], "outputs")
     read = _mat_columns if csv_path.suffix.lower() == ".mat" else _text_columns
@@ -527,7 +553,8 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
         fail(side, "sample_rate_hz", f"missing, and {csv_path.name} has no time column '{meta['time_column']}' to "
              "take the rate from", "the rate in Hz, or time_column naming the file's time column", MeasurementError)
     if time_col:
-        t_file = cols.pop(time_col) * TIME_UNITS[meta["time_unit"]]
+        t_file = cols.pop(time_col)
+        t_file = t_file - t_file[0] if meta["time_unit"] == CLOCK else t_file * TIME_UNITS[meta["time_unit"]]
         stated = fs is not None
         fs = fs if stated else rate_of(t_file)
         check_time(t_file, fs, csv_path, side, time_col, skip + 1, stated)
