@@ -2,6 +2,7 @@
 decimal mark) or damaged at random, is either read to the same numbers or refused with a MeasurementError that
 names the file, never another exception."""
 import codecs
+import datetime
 import pathlib
 
 import numpy as np
@@ -9,7 +10,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from pyfit.io.data import MeasurementError, read_measurement
+from pyfit.io.data import MeasurementError, clock_seconds, read_measurement
 
 FS = 500.0
 N = 40
@@ -138,3 +139,15 @@ def test_a_utf16_sidecar_is_read(tmp_path):
     path = write_pair(tmp_path, lab_text().encode())
     path.with_suffix(".toml").write_bytes(codecs.BOM_UTF16_LE + SIDECAR.encode("utf-16-le"))
     assert read_measurement(path).sample_rate_hz == FS
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.datetimes(min_value=datetime.datetime(1990, 1, 1), max_value=datetime.datetime(2100, 1, 1)), st.booleans())
+def test_a_clock_stamp_reads_to_the_seconds_python_s_datetime_counts(stamp, with_t):
+    """clock_seconds against the standard library's own arithmetic: an ISO date-time's seconds since 1970 (to
+    the 1e-6 s its float keeps over 2e9 s), a time of day's seconds since midnight (exact to the microsecond)."""
+    text = stamp.strftime(f"%Y-%m-%d{'T' if with_t else ' '}%H:%M:%S.%f")
+    since_1970 = (stamp - datetime.datetime(1970, 1, 1)).total_seconds()
+    assert clock_seconds(text) == pytest.approx(since_1970, abs=1e-6)
+    of_day = stamp.hour * 3600 + stamp.minute * 60 + stamp.second + stamp.microsecond * 1e-6
+    assert clock_seconds(stamp.strftime("%H:%M:%S.%f")) == pytest.approx(of_day, abs=1e-9)
