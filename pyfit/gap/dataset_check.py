@@ -12,7 +12,7 @@ import numpy as np
 
 from pyfit.gap import localise
 from pyfit.gap.diagnose import DiagnoseConfig, prepare
-from pyfit.io.data import read_dataset_with_order
+from pyfit.io.data import TO_SI
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,7 @@ def check_dataset(model: str, data_dir, nominal=None, cfg: DiagnoseConfig | None
     p = prepare(model, data_dir, cfg or DiagnoseConfig(), fmu_dir, nominal, candidates)
     try:
         units = {v.name: v.unit or "" for v in p.runner.model_description.modelVariables}
-        measurements = {m.name: m for m in read_dataset_with_order(data_dir)[0]}
+        measurements = {m.name: m for m in p.data.measurements}
         roles = {**{r.name: "calibration" for r in p.data.cal}, **{r.name: "held out" for r in p.data.held},
                  **{name: "set aside" for name in p.data.aside}}
         noise = localise.noise_estimates(p.data.records)
@@ -79,7 +79,7 @@ def check_dataset(model: str, data_dir, nominal=None, cfg: DiagnoseConfig | None
             for side, table in (("input", m.inputs), ("output", m.outputs)):
                 for col, ch in table.items():
                     unit = ch.unit if ch.volts_per_unit is None else \
-                        f"{ch.unit} ({ch.volts_per_unit / _per(ch.unit):g} {ch.unit}/{ch.measures})"
+                        f"{ch.unit} ({ch.volts_per_unit / TO_SI[ch.unit]:g} {ch.unit}/{ch.measures})"
                     v = m.values[col]
                     channels.append(ChannelCheck(col, side, unit, ch.model_variable, units.get(ch.model_variable, ""),
                                                  float(np.sqrt(np.mean((v - np.mean(v)) ** 2))), ch.invert))
@@ -94,11 +94,6 @@ def check_dataset(model: str, data_dir, nominal=None, cfg: DiagnoseConfig | None
                             p.data.recorded_hz)
     finally:
         p.runner.close()
-
-
-def _per(unit: str) -> float:
-    """V per unit of a voltage column's unit (V: 1, mV: 1e-3), to state a sensitivity in the column's unit."""
-    return {"V": 1.0, "mV": 1e-3}[unit]
 
 
 def check_text(c: DatasetCheck) -> str:

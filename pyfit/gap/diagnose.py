@@ -106,6 +106,7 @@ class Dataset:
     rate: AnalysisRate  # the rate the records are analysed at (the files' or decimated: pyfit.gap.rate)
     recorded_hz: dict  # name -> the rate a file was recorded at, where it was faster than the dataset's
     # (rate.common_rate: decimated to the slowest file's rate)
+    measurements: list  # the files as read, in level order (pyfit.io.data.Measurement: columns, units, SI values)
 
 
 def default_calibration(records: list) -> list:
@@ -133,6 +134,7 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
                "outputs": [v.name for v in md_vars if v.causality == "output"]}
     try:
         ms, order = read_dataset_with_order(data_dir)
+        read = list(ms)
     except MeasurementError as exc:
         raise DiagnoseError(str(exc)) from exc
     if len(ms) < 2:
@@ -190,7 +192,8 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
     for m in ms:
         digest.update(m.path.read_bytes())
         digest.update(m.path.with_suffix(".toml").read_bytes())
-    return Dataset(records, cal, held, digest.hexdigest()[:16], order, aside, sorted(voltages), rate, recorded_hz)
+    return Dataset(records, cal, held, digest.hexdigest()[:16], order, aside, sorted(voltages), rate, recorded_hz,
+                   read)
 
 
 def _simulated(runner, records, values: dict, system, cfg: DiagnoseConfig) -> dict:
@@ -955,16 +958,10 @@ def misfit_at(model: str, data_dir, params: dict, cfg: DiagnoseConfig | None = N
     """The FMU of `model` at `params` (over the described nominal's fixed values and the FMU's defaults) on the
     files of `data_dir`, split into calibration and held-out files as `diagnose` splits them with `cfg`: e.g. a
     known truth's misfit, which tells a miss the data cannot decide from a miss of the search."""
-    cfg = cfg or DiagnoseConfig()
-    runner = FmuRunner(str(ensure_fmu(family_fmu(model), pathlib.Path(fmu_dir))))
+    p = prepare(model, data_dir, cfg or DiagnoseConfig(), fmu_dir, nominal)
     try:
-        system = make_system(model, fmu_defaults(runner),
-                             load_nominal(nominal) if isinstance(nominal, (str, pathlib.Path)) else nominal)
-        data = _load(data_dir, system, cfg, runner)
-        cfg = with_drive(cfg, system, data.rate)
-        cal, held = data.cal, data.held
-        values = {**system.nominal_fixed, **params}
-        return SplitMisfit(*(selection.heldout_nrmse(_simulated(runner, files, values, system, cfg), files)
-                             for files in (held, cal)))
+        values = {**p.system.nominal_fixed, **params}
+        return SplitMisfit(*(selection.heldout_nrmse(_simulated(p.runner, files, values, p.system, p.cfg), files)
+                             for files in (p.data.held, p.data.cal)))
     finally:
-        runner.close()
+        p.runner.close()

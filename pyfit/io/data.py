@@ -52,10 +52,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from pyfit.io.schema import ConfigError, check_table, fail, read_text, read_toml
-from pyfit.io.units import parse_unit
+from pyfit.io.units import FOOT, G0, INCH, NUMBER, POUND, parse_unit
 
-G0 = 9.80665  # standard gravity [m/s2], exact by definition
-INCH, FOOT, POUND = 0.0254, 0.3048, 0.45359237  # [m], [m], [kg]: exact by the 1959 international agreement
 TO_SI = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": INCH, "ft": FOOT, "rad": 1.0, "deg": np.pi / 180,
          "m/s": 1.0, "cm/s": 1e-2, "mm/s": 1e-3, "in/s": INCH, "ft/s": FOOT,
          "m/s2": 1.0, "cm/s2": 1e-2, "mm/s2": 1e-3, "in/s2": INCH, "ft/s2": FOOT, "g": G0, "mg": 1e-3 * G0,
@@ -147,7 +145,7 @@ class Channel:
         return sign * TO_SI[self.unit] / self.volts_per_unit * TO_SI[self.measures]
 
 
-SENSITIVITY = re.compile(r"^\s*((?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*(V|mV)\s*/\s*(\S+)\s*$")
+SENSITIVITY = re.compile(rf"^\s*({NUMBER})\s*(V|mV)\s*/\s*(\S+)\s*$")
 
 
 def _sensitivity(side, where: str, text: str, unit: str) -> tuple[float, str]:
@@ -501,8 +499,8 @@ def _mat_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: d
             continue
         fields = getattr(v, "_fieldnames", None)
         found.update({f"{name}.{f}": getattr(v, f) for f in fields} if fields else {name: v})
-    arrays = {n: np.asarray(v) for n, v in found.items()
-              if np.asarray(v).dtype.kind in "biuf" and np.asarray(v).ndim in (1, 2)}
+    arrays = {n: a for n, a in ((n, np.asarray(v)) for n, v in found.items())
+              if a.dtype.kind in "biuf" and a.ndim in (1, 2)}
     if meta["columns"] is not None:
         k = len(meta["columns"])
         matrices = [n for n, a in arrays.items() if a.ndim == 2 and k in a.shape]
@@ -723,11 +721,9 @@ def measurement_files(folder: str | pathlib.Path) -> list[pathlib.Path]:
         raise MeasurementError(f"{folder}: dataset folder not found")
     found = []
     for p in sorted(folder.iterdir()):
-        if not (p.is_file() and p.suffix.lower() in DATA_SUFFIXES):
-            continue
-        if p.with_suffix(".toml").is_file():
+        if _is_measurement(p):
             found.append(p)
-        elif p.suffix.lower() == ".csv":
+        elif p.is_file() and p.suffix.lower() == ".csv":
             raise MeasurementError(f"{p}: no sidecar {p.stem}.toml")
     for a, b in zip(found, found[1:]):
         if a.stem == b.stem:
@@ -736,9 +732,14 @@ def measurement_files(folder: str | pathlib.Path) -> list[pathlib.Path]:
     return found
 
 
+def _is_measurement(p: pathlib.Path) -> bool:
+    """A file ending in one of DATA_SUFFIXES (any case) beside a TOML sidecar of its stem."""
+    return p.is_file() and p.suffix.lower() in DATA_SUFFIXES and p.with_suffix(".toml").is_file()
+
+
 def holds_measurements(folder: pathlib.Path) -> bool:
     """Whether a folder holds a measurement file beside its sidecar (as measurement_files finds them)."""
-    return any(f.suffix.lower() in DATA_SUFFIXES and f.with_suffix(".toml").is_file() for f in folder.iterdir())
+    return any(_is_measurement(p) for p in folder.iterdir())
 
 
 def read_dataset_with_order(folder: str | pathlib.Path) -> tuple[list[Measurement], str]:

@@ -17,6 +17,8 @@ from dataclasses import dataclass
 Dimension = tuple[int, int, int, int]  # exponents of kg, m, s, A
 SI_BASE = ("kg", "m", "s", "A")
 
+G0 = 9.80665  # standard gravity [m/s2], exact by definition
+INCH, FOOT, POUND = 0.0254, 0.3048, 0.45359237  # [m], [m], [kg]: exact by the 1959 international agreement
 _M, _L, _T, _I = (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1)
 _NONE: Dimension = (0, 0, 0, 0)
 
@@ -31,9 +33,9 @@ PREFIXED = {  # symbol -> (factor to coherent SI, dimension); these take an SI p
     "Pa": (1.0, _times((_FORCE, 1), (_L, -2))), "J": (1.0, _times((_FORCE, 1), (_L, 1))),
     "W": (1.0, _times((_FORCE, 1), (_L, 1), (_T, -1))), "V": (1.0, _times((_M, 1), (_L, 2), (_T, -3), (_I, -1))),
     "rad": (1.0, _NONE)}
-UNPREFIXED = {  # symbols that take no prefix (exact definitions: 1959 international yard and pound)
+UNPREFIXED = {  # symbols that take no prefix
     "1": (1.0, _NONE), "min": (60.0, _T), "h": (3600.0, _T), "deg": (math.pi / 180, _NONE),
-    "in": (0.0254, _L), "ft": (0.3048, _L), "lb": (0.45359237, _M), "lbf": (0.45359237 * 9.80665, _FORCE)}
+    "in": (INCH, _L), "ft": (FOOT, _L), "lb": (POUND, _M), "lbf": (POUND * G0, _FORCE)}
 PREFIXES = {"da": 1e1, "Y": 1e24, "Z": 1e21, "E": 1e18, "P": 1e15, "T": 1e12, "G": 1e9, "M": 1e6, "k": 1e3,
             "h": 1e2, "d": 1e-1, "c": 1e-2, "m": 1e-3, "u": 1e-6, "n": 1e-9, "p": 1e-12, "f": 1e-15, "a": 1e-18,
             "z": 1e-21, "y": 1e-24}
@@ -104,7 +106,8 @@ def parse_unit(text: str) -> Unit:
     return Unit(text.strip(), factor, dim)
 
 
-QUANTITY = re.compile(r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*(.*?)\s*$")
+NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"  # a decimal number as a file writes it
+QUANTITY = re.compile(rf"^\s*({NUMBER})\s*(.*?)\s*$")
 
 
 def parse_quantity(text: str) -> tuple[float, Unit | None]:
