@@ -148,3 +148,24 @@ def test_fmus_loaded_from_many_threads_leave_the_working_directory_alone(fmu_dir
     with ThreadPoolExecutor(8) as pool:
         list(pool.map(load_and_close, range(32)))
     assert os.getcwd() == here
+
+
+def test_pool_workers_start_with_the_task_module_already_imported(tmp_path):
+    """A local pool's workers fork from a server that imported the task's module once (map_tasks sets the
+    forkserver's preload): a module that records the process it was imported in reports the server in every
+    worker, neither the worker itself (each importing it again) nor the parent. Run in a fresh interpreter: a
+    process's forkserver reads its preload list only when it starts."""
+    (tmp_path / "where_imported.py").write_text(
+        "import os\nIMPORTED_IN = os.getpid()\n\n\ndef where(_):\n    return IMPORTED_IN, os.getpid()\n")
+    script = ("import os\nfrom where_imported import where\nfrom pyfit.runtime.batch import map_tasks\n"
+              "print(os.getpid(), *(f'{a}:{b}' for a, b in map_tasks(where, range(4), workers=2, progress=False)))\n")
+    # on the module search path of every process (the server imports by name from the path it starts with)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(tmp_path), os.environ.get("PYTHONPATH")]))}
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=True,
+                         env=env)
+    parent, *runs = out.stdout.split()
+    pairs = [tuple(r.split(":")) for r in runs]
+    assert len(pairs) == 4
+    servers = {imported for imported, _ in pairs}
+    assert len(servers) == 1 and parent not in servers, (parent, pairs)
+    assert all(imported != worker for imported, worker in pairs), pairs

@@ -170,13 +170,19 @@ def test_a_damper_driven_by_an_integrated_clamp_motion_starts_at_rest_relative_t
                                                               / np.mean(rec.outputs["x1"] ** 2))), 0.03)
 
 
-def test_a_parameter_set_the_integrator_crawls_through_fails_at_a_limit_set_by_the_nominal(tmp_path, runner):
+def test_a_parameter_set_the_integrator_crawls_through_fails_at_a_limit_set_by_the_nominal(tmp_path, runner,
+                                                                                             monkeypatch):
     """A 4 s force sweep through the SDOF's linear resonance (35.6 Hz, 0.6 mm). A Bouc-Wen loop with
     β(γ + δ) = 1e10 m⁻¹ yields within 1e-10 m: its z equation has a rate near β(γ + δ)|ẋ| ≈ 1e9 s⁻¹, and the FMU's
     explicit Dormand-Prince steps stay below ~3/1e9 s, billions of steps for the record (hours). With the limit
     sim.with_time_limits sets from the linear model's own simulation (SLOW_FACTOR times its time, at least
     MIN_WALL_S) the run counts as failed within that limit instead of MAX_WALL_S; a strong loop that yields within
-    1e-6 m is no such set and simulates."""
+    1e-6 m is no such set and simulates. The limit is set from runs of the FMU, each made (a run the process
+    remembers would time a look-up, and the limit fall to its floor whatever the record costs)."""
+    from pyfit.runtime import drive
+
+    real_driven, made = drive._driven, []
+    monkeypatch.setattr(drive, "_driven", lambda *a, **k: made.append(1) or real_driven(*a, **k))
     fs = 500.0
     exc = Excitation(2, 50.0, 20.0, 50.0, 1.5)
     t, y, u = simulate_truth(SyntheticSpec("SDOFBoucWen", exc, 4.0, fs, ["y"], TRUTH, oversample=10,
@@ -186,10 +192,51 @@ def test_a_parameter_set_the_integrator_crawls_through_fails_at_a_limit_set_by_t
     fmu = runner("SDOFBoucWen")
     rec = sim.record_of(read_measurement(path))
     assert rec.max_wall_s == sim.MAX_WALL_S
-    limited, = sim.with_time_limits(fmu, [rec], {**TRUTH, "exc_type": 0})
+    limited, = sim.with_time_limits(fmu, [rec], {**TRUTH, "exc_type": 0}, repeats=3)
+    assert len(made) == 3  # each timed run made, none returned from the process's memory
     assert sim.MIN_WALL_S <= limited.max_wall_s <= 0.1 * sim.MAX_WALL_S  # a 4 s record: well under a second
     loop = {**TRUTH, "exc_type": 0, "alpha": 5e4, "gamma": 0.5, "delta": 0.5, "nu": 1.0}
     assert sim.simulate(fmu, limited, {**loop, "beta": 1e6}) is not None
     t0 = time.perf_counter()
     assert sim.simulate(fmu, limited, {**loop, "beta": 1e10}) is None
     assert time.perf_counter() - t0 < 0.25 * sim.MAX_WALL_S  # cut by the record's limit, not the 60 s one
+
+
+def test_a_softening_spring_pushed_past_its_peak_force_fails_where_it_escapes(runner):
+    """m x'' + c x' + k x + k3 x³ = u with k3 < 0: the spring force peaks at x* = sqrt(k / (3|k3|)), F* = 2 k x* / 3.
+    A force ramped to 0.8 F* and held is carried (the FMU follows scipy's Radau solution); one ramped to 1.2 F*
+    is not: x runs off to infinity, and the FMU's run fails in the communication step where scipy's solution
+    passes 100 x*, on the step-size rule (the step below a share of the communication step), not at the limit of
+    the arithmetic far beyond."""
+    import scipy.integrate
+
+    p = {**TRUTH, "exc_type": 0, "k3": -1e11}
+    x_star = np.sqrt(p["k"] / (3 * abs(p["k3"])))
+    f_star = 2.0 * p["k"] * x_star / 3.0
+    dt, stop = 1e-3, 1.5
+    t = np.arange(int(round(stop / dt)) + 1) * dt
+    ramp = np.minimum(t / 0.5, 1.0) ** 2 * (3 - 2 * np.minimum(t / 0.5, 1.0))  # smooth step over 0.5 s
+
+    def escape(_, s):
+        return abs(s[0]) - 100 * x_star
+    escape.terminal = True
+
+    for share, carried in ((0.8, True), (1.2, False)):
+        force = share * f_star * ramp
+
+        def rhs(tt, s):
+            u = np.interp(tt, t, force)
+            return [s[1], (u - p["c"] * s[1] - p["k"] * s[0] - p["k3"] * s[0] ** 3) / p["m"]]
+
+        ref = scipy.integrate.solve_ivp(rhs, (0, stop), [0.0, 0.0], "Radau", t_eval=t, rtol=1e-10, atol=1e-14,
+                                        events=escape, max_step=dt / 4)
+        res = runner("SDOFBoucWen").simulate(stop, dt, ["y"], p, {"u": force}, t, tolerance=1e-8)
+        if carried:
+            assert ref.status == 0 and res.ok, res.message
+            err = np.max(np.abs(res["y"] - ref.y[0])) / np.max(np.abs(ref.y[0]))
+            assert err < 1e-7, err  # both integrate the same linear input at tolerances of 1e-8 and below
+        else:
+            t_escape = ref.t_events[0][0]
+            assert not res.ok and "the step fell below 1e-08 of the communication step" in res.message, res.message
+            t_fail = float(res.message.split("from t = ")[1].split(":")[0])
+            assert t_fail <= t_escape < t_fail + dt, (t_fail, t_escape)

@@ -102,6 +102,12 @@ def map_tasks(fn, items: list, workers: int | None = None, scheduler=None, progr
             # (torch, BLAS) could be holding locks at the moment of a fork
             method = "forkserver" if sys.platform.startswith("linux") else "spawn"
             ctx = multiprocessing.get_context(method)
+            module = getattr(fn, "__module__", None)  # None for some callables (a numpy ufunc)
+            if method == "forkserver" and module not in (None, "__main__"):
+                # the server imports fn's module once (numpy, scipy, fmpy with it): the workers it forks have it
+                # instead of importing it each (about a second and a half of a core per worker for a diagnosis's
+                # fits). Only the server's first start reads the list.
+                ctx.set_forkserver_preload([module])
             pool = cf.ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1, mp_context=ctx,
                                           initializer=_watch_parent, initargs=(os.getpid(),))
             previous = signal.signal(signal.SIGTERM, _interrupt) \

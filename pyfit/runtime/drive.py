@@ -84,21 +84,22 @@ def remembered_derivatives(fine: dict[str, np.ndarray], dt: float, key: str) -> 
 
 def drive(runner: FmuRunner, inputs: dict[str, np.ndarray], fs: float, outputs: list[str], params: dict,
           upsample: int = 4, samples_per_period: int | None = None, lead_periods: int = 0,
-          tolerance: float = 1e-8, max_wall_s: float | None = None, smooth_inputs: bool = False
-          ) -> SimulationResult:
+          tolerance: float = 1e-8, max_wall_s: float | None = None, smooth_inputs: bool = False,
+          remembered: bool = True) -> SimulationResult:
     """Simulate the FMU driven by measured inputs (model variable -> samples at fs [Hz]); with smooth_inputs,
     by the cubic spline of the upsampled samples (co-simulation FMUs that take input derivatives of order 2).
 
     Returns the outputs at the record's own samples (t = 0, 1/fs, ...), as many as the inputs have; a run
     that fails, returns a non-finite value or takes longer than max_wall_s seconds gives ok=False with the
     reason (never an exception). A successful run this process made with the same FMU file, inputs, parameters
-    and settings is not made again: its outputs are returned (copies; the same values to the bit)."""
+    and settings is not made again: its outputs are returned (copies; the same values to the bit); with
+    remembered=False the run is made in any case (to time it)."""
     file = pathlib.Path(runner.path).stat()
     source = digest({k: np.asarray(v, float) for k, v in inputs.items()})  # hashed once per run
     key = digest(runner.path, runner.interface, file.st_mtime_ns, file.st_size, source, fs, list(outputs),
                  sorted(params.items()), int(upsample), samples_per_period or 0, lead_periods, tolerance,
                  bool(smooth_inputs))
-    known = RESPONSE_MEMO.get(key)
+    known = RESPONSE_MEMO.get(key) if remembered else None
     if known is not None:
         return SimulationResult(known.time.copy(), {k: v.copy() for k, v in known.values.items()})
     res = _driven(runner, inputs, fs, outputs, params, upsample, samples_per_period, lead_periods, tolerance,
