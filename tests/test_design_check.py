@@ -273,9 +273,13 @@ def test_measured_impedance_file_replaces_the_damper_model(tmp_path):
 def test_impedance_file_errors_name_the_problem(tmp_path):
     from pyfit.io.data import MeasurementError
     from pyfit.io.impedance import read_impedance
-    csv = _write_impedance_test(tmp_path, [(10.0, 50.0, 40.0, 30.0)], units=("Hz", "km/h", "N.s/m", "deg"))
-    with pytest.raises(MeasurementError, match=r"\[columns.velocity.unit\] unit 'km/h'; allowed: m/s, mm/s"):
+    csv = _write_impedance_test(tmp_path, [(10.0, 50.0, 40.0, 30.0)], units=("Hz", "m/s2", "N.s/m", "deg"))
+    with pytest.raises(MeasurementError, match=r"\[columns.velocity.unit\] unit 'm/s2'; allowed: a unit of m/s, "
+                                               r"e\.g\. m/s, mm/s, in/s"):
         read_impedance(csv)
+    # a velocity in any unit of one reads (50 km/h = 50 / 3.6 m/s)
+    csv = _write_impedance_test(tmp_path, [(10.0, 50.0, 40.0, 30.0)], units=("Hz", "km/h", "N.s/m", "deg"))
+    assert read_impedance(csv).amplitudes[0, 0] == pytest.approx(50.0 / 3.6 / (2 * np.pi * 10.0), rel=1e-14)
     csv = _write_impedance_test(tmp_path, [(10.0, 50.0, 40.0, 30.0), (10.0, 100.0, 41.0, 31.0), (20.0, 50.0, 40.0, 30.0)])
     with pytest.raises(MeasurementError, match=r"\[frequency\] levels per frequency differ"):
         read_impedance(csv)

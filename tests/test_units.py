@@ -2,6 +2,7 @@
 definitions written out (SI prefixes; 1 in = 25.4 mm, 1 lb = 0.45359237 kg, g0 = 9.80665 m/s², exact)."""
 import math
 
+import numpy as np
 import pytest
 from fmpy import read_model_description
 from hypothesis import given, settings
@@ -77,3 +78,32 @@ def test_quantities_read_as_si(text, value, unit):
 def test_bad_quantities_say_what_does_not_read(text, match):
     with pytest.raises(ValueError, match=match):
         parse_quantity(text)
+
+
+def test_an_impedance_test_in_a_catalogue_s_units_reads_as_its_si_twin(tmp_path):
+    """A damper impedance test written in in/s, kHz, lbf·s/in and rad reads to the numbers of the same test in
+    Hz, m and N·s/m (definitions written out: 1 in = 0.0254 m, 1 lbf = 0.45359237 kg × 9.80665 m/s²); a unit of
+    another quantity is refused naming the file, the key and the quantity's SI unit."""
+    from pyfit.io.data import MeasurementError
+    from pyfit.io.impedance import read_impedance, write_impedance
+
+    f, a = [8.0, 21.0], [[1e-4, 3e-4], [2e-5, 6e-5]]
+    z = np.array([[120 * np.exp(0.4j), 118 * np.exp(0.5j)], [40 * np.exp(-0.3j), 41 * np.exp(-0.2j)]])
+    si = read_impedance(write_impedance(tmp_path / "si.csv", f, a, z))
+    lbf_s_per_in = 0.45359237 * 9.80665 / 0.0254
+    rows = [(fi / 1e3, 2 * np.pi * fi * aij / 0.0254, abs(zij) / lbf_s_per_in, np.angle(zij))
+            for fi, ai, zi in zip(f, a, z) for aij, zij in zip(ai, zi)]
+    np.savetxt(tmp_path / "us.csv", rows, delimiter=",", header="f_khz,v_ips,z,phi", comments="", fmt="%.17g")
+    sidecar = ('kind = "damper_impedance"\n[columns]\nfrequency = { name = "f_khz", unit = "kHz" }\n'
+               'velocity = { name = "v_ips", unit = "in/s" }\nimpedance = { name = "z", unit = "lbf·s/in" }\n'
+               'phase = { name = "phi", unit = "rad" }\n')
+    (tmp_path / "us.toml").write_text(sidecar)
+    us = read_impedance(tmp_path / "us.csv")
+    np.testing.assert_allclose(us.frequencies, si.frequencies, rtol=1e-14)
+    # the SI file holds 9 significant digits (write_impedance's format); the other 17
+    np.testing.assert_allclose(us.amplitudes, si.amplitudes, rtol=1e-8)
+    np.testing.assert_allclose(us.impedance, si.impedance, rtol=1e-8)
+    (tmp_path / "us.toml").write_text(sidecar.replace("lbf·s/in", "N/m"))
+    with pytest.raises(MeasurementError, match=r"us\.toml: \[columns\.impedance\.unit\] unit 'N/m'; allowed: a "
+                                               r"unit of kg/s, e\.g\. N\.s/m"):
+        read_impedance(tmp_path / "us.csv")

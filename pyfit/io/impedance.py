@@ -11,7 +11,9 @@ like any lab export: comment lines, extra columns, ',' or tab) and a TOML sideca
     notes = "..."
     uncertainty = 0.01    # optional: the test's relative error, RMS of |Z_meas / Z_true - 1| (for diagnose.py)
 
-Every frequency must have been tested at the same number of levels. The result, an `ImpedanceTest` (each
+A unit may be any unit of its column's quantity (`pyfit.io.units`: SI prefixes, in, ft, lbf, and the forms
+people write, 'N·s/m', 'Ns/m'); the phase in deg or rad. Every frequency must have been tested at the same
+number of levels. The result, an `ImpedanceTest` (each
 frequency with its own clamp amplitudes a = v / 2πf), becomes the damper table of the energy balance and the
 span design check in place of the damper FMU's (`DamperPowerTable.from_test`); `DamperPowerTable.save`
 writes the FMU's table in the same columns (`*_impedance.csv`).
@@ -26,13 +28,27 @@ import numpy as np
 
 from pyfit.io.data import MeasurementError, read_csv_columns
 from pyfit.io.schema import check_table, fail, read_toml
+from pyfit.io.units import parse_unit
 
-UNITS = {"frequency": {"Hz": 1.0},
-         "velocity": {"m/s": 1.0, "mm/s": 1e-3},
-         "displacement": {"m": 1.0, "mm": 1e-3},
-         "impedance": {"N.s/m": 1.0, "N·s/m": 1.0, "Ns/m": 1.0, "kg/s": 1.0},
-         "phase": {"deg": np.pi / 180, "rad": 1.0}}
+# each column's quantity: a unit of its dimension (pyfit.io.units: any SI prefix, in, ft, lbf, the written forms
+# 'N·s/m', 'N s/m', 'N*s/m'), named in an error by the examples given here; a phase in deg or rad (an angle, which
+# the dimension alone does not tell from a plain number)
+QUANTITIES = {"frequency": "Hz", "velocity": "m/s", "displacement": "m", "impedance": "N.s/m", "phase": "rad"}
+EXAMPLES = {"frequency": "Hz, kHz, 1/min", "velocity": "m/s, mm/s, in/s", "displacement": "m, mm, in",
+            "impedance": "N.s/m, N·s/m, Ns/m, kg/s, lbf.s/in", "phase": "deg, rad"}
+ANGLES = {"deg": np.pi / 180, "rad": 1.0}
 COLUMN = {"name": (str, True, None), "unit": (str, True, None)}
+
+
+def _factor(key: str, unit: str) -> float | None:
+    """The factor taking a value of column `key` in `unit` to SI; None when the unit is not one of its quantity."""
+    if key == "phase":
+        return ANGLES.get(unit.strip())
+    try:
+        u = parse_unit(unit.replace("Ns", "N.s"))  # 'Ns/m', as catalogues write N·s/m
+    except ValueError:
+        return None
+    return u.factor if u.dimension == parse_unit(QUANTITIES[key]).dimension else None
 
 
 @dataclass(frozen=True)
@@ -60,7 +76,7 @@ def read_impedance(csv_path) -> ImpedanceTest:
              MeasurementError)
     if top["kind"] != "damper_impedance":
         fail(side, "kind", f"{top['kind']!r} is not an impedance test", "damper_impedance", MeasurementError)
-    spec = {k: (dict, k in ("frequency", "impedance", "phase"), None) for k in UNITS}
+    spec = {k: (dict, k in ("frequency", "impedance", "phase"), None) for k in QUANTITIES}
     cols = check_table(top["columns"], side, "columns", spec, MeasurementError)
     if (cols["velocity"] is None) == (cols["displacement"] is None):
         fail(side, "columns", "give exactly one of velocity and displacement (the clamp's amplitude)",
@@ -70,9 +86,11 @@ def read_impedance(csv_path) -> ImpedanceTest:
         if entry is None:
             continue
         c = check_table(entry, side, f"columns.{key}", COLUMN, MeasurementError)
-        if c["unit"] not in UNITS[key]:
-            fail(side, f"columns.{key}.unit", f"unit {c['unit']!r}", ", ".join(UNITS[key]), MeasurementError)
-        used[key] = (c["name"], UNITS[key][c["unit"]])
+        factor = _factor(key, c["unit"])
+        if factor is None:
+            fail(side, f"columns.{key}.unit", f"unit {c['unit']!r}",
+                 f"a unit of {parse_unit(QUANTITIES[key]).describe()}, e.g. {EXAMPLES[key]}", MeasurementError)
+        used[key] = (c["name"], factor)
     values = read_csv_columns(csv_path, [name for name, _ in used.values()])
     si = {key: values[name] * scale for key, (name, scale) in used.items()}
     f = si["frequency"]
