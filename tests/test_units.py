@@ -83,7 +83,8 @@ def test_bad_quantities_say_what_does_not_read(text, match):
 def test_an_impedance_test_in_a_catalogue_s_units_reads_as_its_si_twin(tmp_path):
     """A damper impedance test written in in/s, kHz, lbf·s/in and rad reads to the numbers of the same test in
     Hz, m and N·s/m (definitions written out: 1 in = 0.0254 m, 1 lbf = 0.45359237 kg × 9.80665 m/s²); a unit of
-    another quantity is refused naming the file, the key and the quantity's SI unit."""
+    another quantity is refused naming the file, the key and the quantity's SI unit, a phase in neither deg nor
+    rad naming those."""
     from pyfit.io.data import MeasurementError
     from pyfit.io.impedance import read_impedance, write_impedance
 
@@ -106,4 +107,7 @@ def test_an_impedance_test_in_a_catalogue_s_units_reads_as_its_si_twin(tmp_path)
     (tmp_path / "us.toml").write_text(sidecar.replace("lbf·s/in", "N/m"))
     with pytest.raises(MeasurementError, match=r"us\.toml: \[columns\.impedance\.unit\] unit 'N/m'; allowed: a "
                                                r"unit of kg/s, e\.g\. N\.s/m"):
+        read_impedance(tmp_path / "us.csv")
+    (tmp_path / "us.toml").write_text(sidecar.replace('"rad"', '"1"'))  # dimensionless, but which angle?
+    with pytest.raises(MeasurementError, match=r"\[columns\.phase\.unit\] unit '1'; allowed: deg, rad"):
         read_impedance(tmp_path / "us.csv")

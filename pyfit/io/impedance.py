@@ -33,10 +33,11 @@ from pyfit.io.units import parse_unit
 # each column's quantity: a unit of its dimension (pyfit.io.units: any SI prefix, in, ft, lbf, the written forms
 # 'N·s/m', 'N s/m', 'N*s/m'), named in an error by the examples given here; a phase in deg or rad (an angle, which
 # the dimension alone does not tell from a plain number)
-QUANTITIES = {"frequency": "Hz", "velocity": "m/s", "displacement": "m", "impedance": "N.s/m", "phase": "rad"}
+QUANTITIES = {"frequency": "Hz", "velocity": "m/s", "displacement": "m", "impedance": "N.s/m"}
 EXAMPLES = {"frequency": "Hz, kHz, 1/min", "velocity": "m/s, mm/s, in/s", "displacement": "m, mm, in",
-            "impedance": "N.s/m, N·s/m, Ns/m, kg/s, lbf.s/in", "phase": "deg, rad"}
+            "impedance": "N.s/m, N·s/m, Ns/m, kg/s, lbf.s/in"}
 ANGLES = {"deg": np.pi / 180, "rad": 1.0}
+COLUMNS = (*QUANTITIES, "phase")
 COLUMN = {"name": (str, True, None), "unit": (str, True, None)}
 
 
@@ -76,7 +77,7 @@ def read_impedance(csv_path) -> ImpedanceTest:
              MeasurementError)
     if top["kind"] != "damper_impedance":
         fail(side, "kind", f"{top['kind']!r} is not an impedance test", "damper_impedance", MeasurementError)
-    spec = {k: (dict, k in ("frequency", "impedance", "phase"), None) for k in QUANTITIES}
+    spec = {k: (dict, k in ("frequency", "impedance", "phase"), None) for k in COLUMNS}
     cols = check_table(top["columns"], side, "columns", spec, MeasurementError)
     if (cols["velocity"] is None) == (cols["displacement"] is None):
         fail(side, "columns", "give exactly one of velocity and displacement (the clamp's amplitude)",
@@ -88,7 +89,7 @@ def read_impedance(csv_path) -> ImpedanceTest:
         c = check_table(entry, side, f"columns.{key}", COLUMN, MeasurementError)
         factor = _factor(key, c["unit"])
         if factor is None:
-            fail(side, f"columns.{key}.unit", f"unit {c['unit']!r}",
+            fail(side, f"columns.{key}.unit", f"unit {c['unit']!r}", ", ".join(ANGLES) if key == "phase" else
                  f"a unit of {parse_unit(QUANTITIES[key]).describe()}, e.g. {EXAMPLES[key]}", MeasurementError)
         used[key] = (c["name"], factor)
     values = read_csv_columns(csv_path, [name for name, _ in used.values()])
