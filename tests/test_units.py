@@ -16,6 +16,9 @@ KG, M, S = (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0)
 @pytest.mark.parametrize("text, factor, dimension", [
     ("N.m2", 1.0, (1, 3, -2, 0)),            # the FMUs' EI
     ("N·m²", 1.0, (1, 3, -2, 0)),
+    ("Nm2", 1.0, (1, 3, -2, 0)),             # as catalogues write them, without a separator
+    ("kNs/m", 1e3, (1, 0, -1, 0)),
+    ("Nmm", 1e-3, (1, 2, -2, 0)),
     ("N*mm^2", 1e-6, (1, 3, -2, 0)),
     ("kg.m2", 1.0, (1, 2, 0, 0)),
     ("g·cm²", 1e-3 * 1e-4, (1, 2, 0, 0)),

@@ -92,8 +92,9 @@ def unit_key(unit: str) -> str:
     return u if u in TO_SI or u in TIME_UNITS else _same_as(spaced) or u
 
 
-_DIMENSION = {"length": (0, 1, 0, 0), "velocity": (0, 1, -1, 0), "acceleration": (0, 1, -2, 0),
-              "force": (1, 1, -2, 0), "voltage": (1, 2, -3, -1), "angle": (0, 0, 0, 0)}  # of QUANTITY's names
+_DIMENSION = {q: parse_unit(u).dimension for q, u in (("length", "m"), ("velocity", "m/s"), ("acceleration", "m/s2"),
+                                                     ("force", "N"), ("voltage", "V"), ("angle", "rad"))}
+# of QUANTITY's names
 
 
 @functools.lru_cache(maxsize=None)

@@ -46,7 +46,7 @@ def _factor(key: str, unit: str) -> float | None:
     if key == "phase":
         return ANGLES.get(unit.strip())
     try:
-        u = parse_unit(unit.replace("Ns", "N.s"))  # 'Ns/m', as catalogues write N·s/m
+        u = parse_unit(unit)
     except ValueError:
         return None
     return u.factor if u.dimension == parse_unit(QUANTITIES[key]).dimension else None

@@ -1,6 +1,6 @@
 """Unit strings as a factor to coherent SI and a dimension: the Modelica unit grammar the FMUs declare
 ('N.m2', 'kg.m2', 'N.s2/m2', '1/s') and the forms people write in a file ('N·m²', 'kg*mm^2', 'N s^2/m^2',
-'g.cm2', 'lbf', 'in').
+'g.cm2', 'lbf', 'in', and the newton run into the next symbol as catalogues do: 'Nm2', 'Ns/m').
 
 A unit is a product of factors, each a symbol with an optional SI prefix and an optional integer exponent,
 then optionally '/' and the factors it divides by (in brackets, or one factor per '/'). A dimension is the
@@ -95,6 +95,7 @@ def parse_unit(text: str) -> Unit:
     for a, b in _WRITTEN:
         s = s.replace(a, b)
     s = re.sub(r"(\^|\*\*)(?=-?\d)", "", s).replace("*", ".")
+    s = re.sub(r"N(?=[sm])", "N.", s)  # 'Ns/m', 'Nm', 'Nm2' as catalogues write N·s/m, N·m, N·m² (no prefix is 'N')
     s = re.sub(r"\s+", ".", s)
     if not s:
         raise ValueError("empty unit")

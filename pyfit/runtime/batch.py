@@ -105,8 +105,7 @@ def map_tasks(fn, items: list, workers: int | None = None, scheduler=None, progr
             module = getattr(fn, "__module__", None)  # None for some callables (a numpy ufunc)
             if method == "forkserver" and module not in (None, "__main__"):
                 # the server imports fn's module once (numpy, scipy, fmpy with it): the workers it forks have it
-                # instead of importing it each (about a second and a half of a core per worker for a diagnosis's
-                # fits). Only the server's first start reads the list.
+                # instead of importing it each (bench/pool_start.py). Only the server's first start reads the list.
                 ctx.set_forkserver_preload([module])
             pool = cf.ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1, mp_context=ctx,
                                           initializer=_watch_parent, initargs=(os.getpid(),))
