@@ -102,10 +102,11 @@ if __name__ == "__main__":
 
 
 def _alive(pid: int) -> bool:
-    """Running (a zombie, exited but not yet reaped, counts as gone)."""
+    """Running (a zombie, exited but not yet reaped, counts as gone; so does one that exits while its status is
+    read, which the kernel reports as ProcessLookupError rather than FileNotFoundError)."""
     try:
         return pathlib.Path(f"/proc/{pid}/status").read_text().split("State:")[1].split()[0] != "Z"
-    except (FileNotFoundError, IndexError):
+    except (OSError, IndexError):
         return False
 
 
