@@ -438,7 +438,9 @@ def test_an_inverted_sensor_is_read_in_the_model_s_sign_convention(tmp_path):
 
 def _mat_twin(tmp_path, name: str, layout: str, **savemat) -> tuple[pathlib.Path, object]:
     """A MATLAB file holding the columns of lab_file's CSV in one of the layouts a lab saves them in, beside the
-    CSV's sidecar (plus `columns` for a matrix), and the CSV's own reading."""
+    CSV's sidecar (plus `columns` for a matrix), and the CSV's own reading. Written by scipy (v4 to v7), or by
+    hdf5storage in MATLAB's v7.3 layout (HDF5) where savemat asks for format '7.3'."""
+    import hdf5storage
     import scipy.io
 
     csv = lab_file(tmp_path, name)
@@ -457,13 +459,17 @@ def _mat_twin(tmp_path, name: str, layout: str, **savemat) -> tuple[pathlib.Path
         side = 'columns = ["t", "x_mm", "F_kN"]\n' + side
     csv.unlink()
     mat = csv.with_suffix(".mat")
-    scipy.io.savemat(mat, content, **savemat)
+    if savemat.get("format") == "7.3":
+        hdf5storage.savemat(str(mat), content, matlab_compatible=True, **savemat)
+    else:
+        scipy.io.savemat(mat, content, **savemat)
     mat.with_suffix(".toml").write_text(side)
     return mat, twin
 
 
 @pytest.mark.parametrize("layout, savemat", [("vectors", {}), ("vectors", {"format": "4"}), ("struct", {}),
-                                             ("matrix", {"do_compression": True})])
+                                             ("matrix", {"do_compression": True}), ("vectors", {"format": "7.3"}),
+                                             ("struct", {"format": "7.3"}), ("matrix", {"format": "7.3"})])
 def test_a_matlab_file_reads_to_the_numbers_of_its_csv_twin(tmp_path, layout, savemat):
     mat, twin = _mat_twin(tmp_path, "run", layout, **savemat)
     m = read_measurement(mat)
@@ -474,22 +480,25 @@ def test_a_matlab_file_reads_to_the_numbers_of_its_csv_twin(tmp_path, layout, sa
     assert [i.path.name for i in items] == ["run.mat"]
 
 
-def test_a_matlab_file_that_cannot_be_used_is_refused_naming_the_fix(tmp_path):
+@pytest.mark.parametrize("savemat", [{}, {"format": "7.3"}], ids=["v5", "v7.3"])
+def test_a_matlab_file_that_cannot_be_used_is_refused_naming_the_fix(tmp_path, savemat):
+    """The vectors listed are the numeric ones (the text variable beside them is not), in either format."""
     import struct
 
-    mat, _ = _mat_twin(tmp_path, "run", "vectors")
+    mat, _ = _mat_twin(tmp_path, "run", "vectors", **savemat)
     side = mat.with_suffix(".toml")
     side.write_text(side.read_text().replace("x_mm =", "x =", 1))
-    with pytest.raises(MeasurementError, match=r"run.mat: variable 'x' named in run.toml is missing; vectors: t, "
-                                               r"x_mm, F_kN; allowed: a MATLAB file of format v4 to v7.2"):
+    listed = "t, x_mm, F_kN" if not savemat else "F_kN, t, x_mm"  # file order; HDF5 lists its names sorted
+    with pytest.raises(MeasurementError, match=rf"run.mat: variable 'x' named in run.toml is missing; vectors: "
+                                               rf"{listed}; allowed: a MATLAB file \(v4, v6, v7 or v7.3\)"):
         read_measurement(mat)
     side.write_text('columns = ["t", "x_mm"]\n' + side.read_text())
     with pytest.raises(MeasurementError, match=r"\[columns\] 2 names, and run.mat holds 0 matrices"):
         read_measurement(mat)
-    # MATLAB's -v7.3 format is HDF5: its 128-byte header says so (version 0x0200)
+    # a v7.3 header (version 0x0200) over no HDF5 content: a damaged or truncated file
     header = b"MATLAB 7.3 MAT-file, HDF5 schema 1.00 .".ljust(116) + bytes(8) + struct.pack("<H", 0x0200) + b"IM"
     mat.write_bytes(header + bytes(512))
-    with pytest.raises(MeasurementError, match=r"run.mat: a MATLAB v7.3 \(HDF5\) file; allowed: .*'-v7'"):
+    with pytest.raises(MeasurementError, match=r"run.mat: not readable as a MATLAB file \(.*v7.3"):
         read_measurement(mat)
     mat.write_bytes(b"t,x_mm\n0,1\n" * 30)
     with pytest.raises(MeasurementError, match=r"run.mat: not readable as a MATLAB file"):

@@ -1,5 +1,5 @@
 """Measurement files (theory §5): a CSV (or .txt, .dat, .tsv, .asc; any case) plus a TOML sidecar of the same stem,
-or a MATLAB .mat file (v4 to v7.2: scipy.io.loadmat) whose vectors, a struct's fields ('s.x') or one matrix's
+or a MATLAB .mat file (any format, v4 to v7.3: pyfit.io.matlab) whose vectors, a struct's fields ('s.x') or one matrix's
 columns (named by the sidecar's `columns`) are the columns.
 
 Sidecar keys: model, sample_rate_hz (optional where the file has a time column: its rate, rate_of), [inputs]
@@ -51,6 +51,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from pyfit.io.matlab import MatlabFileError, mat_variables
 from pyfit.io.schema import ConfigError, check_table, fail, read_text, read_toml
 from pyfit.io.units import FOOT, G0, INCH, NUMBER, POUND, parse_unit
 
@@ -474,34 +475,21 @@ def _text_columns(csv_path: pathlib.Path, side: pathlib.Path, meta: dict, channe
             skip)
 
 
-MAT_ALLOWED = ("a MATLAB file of format v4 to v7.2 (MATLAB's default; save(..., '-v7') for a v7.3 file) holding "
-               "the columns as vectors of one length, as fields of a struct ('s.x'), or as the columns of one "
-               "matrix the sidecar's `columns` names")
+MAT_ALLOWED = ("a MATLAB file (v4, v6, v7 or v7.3) holding the columns as vectors of one length, as fields of a "
+               "struct ('s.x'), or as the columns of one matrix the sidecar's `columns` names")
 
 
 def _mat_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
-    """The used columns of a MATLAB file (scipy.io.loadmat), as _text_columns gives a text file's: vectors by
+    """The used columns of a MATLAB file (pyfit.io.matlab), as _text_columns gives a text file's: vectors by
     their names, a struct's fields as 'struct.field', or the columns (or rows) of the one matrix whose size
     matches the sidecar's `columns`, by those names."""
-    import scipy.io
-
     if meta["time_unit"] == CLOCK:
         fail(side, "time_unit", f"'{CLOCK}' for {path.name}: clock stamps are text", "s or ms for a MATLAB file's "
              "time vector", MeasurementError)
     try:
-        raw = scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False)
-    except NotImplementedError as exc:  # scipy's answer to a v7.3 (HDF5) file
-        raise MeasurementError(f"{path}: a MATLAB v7.3 (HDF5) file; allowed: {MAT_ALLOWED}") from exc
-    except (ValueError, TypeError, OSError, scipy.io.matlab.MatReadError) as exc:  # not a MATLAB file
+        arrays = mat_variables(path)
+    except MatlabFileError as exc:
         raise MeasurementError(f"{path}: not readable as a MATLAB file ({exc}); allowed: {MAT_ALLOWED}") from exc
-    found = {}
-    for name, v in raw.items():
-        if name.startswith("__"):
-            continue
-        fields = getattr(v, "_fieldnames", None)
-        found.update({f"{name}.{f}": getattr(v, f) for f in fields} if fields else {name: v})
-    arrays = {n: a for n, a in ((n, np.asarray(v)) for n, v in found.items())
-              if a.dtype.kind in "biuf" and a.ndim in (1, 2)}
     if meta["columns"] is not None:
         k = len(meta["columns"])
         matrices = [n for n, a in arrays.items() if a.ndim == 2 and k in a.shape]
