@@ -505,6 +505,136 @@ def test_a_matlab_file_that_cannot_be_used_is_refused_naming_the_fix(tmp_path, s
         read_measurement(mat)
 
 
+def _tdms_twin(tmp_path, layout: str) -> tuple[pathlib.Path, object]:
+    """An NI TDMS file (written by npTDMS's writer) holding the columns of lab_file's CSV as NI DAQ software logs
+    them, beside the CSV's sidecar, and the CSV's own reading: 'waveforms' (channels with wf_increment and
+    unit_string, no time channel, the sidecar without sample_rate_hz), 'time channel' (a channel 't' beside
+    them, no waveform timing) or 'groups' (a second group holding a channel named as the used displacement:
+    the sidecar names it 'Laser/x_mm')."""
+    from nptdms import ChannelObject, GroupObject, TdmsWriter
+
+    csv = lab_file(tmp_path, "run")
+    twin = read_measurement(csv)
+    t, x, force = np.loadtxt(csv, delimiter=",", skiprows=3, usecols=(0, 1, 2)).T
+    side = csv.with_suffix(".toml").read_text()
+    wave = {"wf_increment": 1.0 / FS, "wf_start_offset": 0.0}
+    if layout == "waveforms":
+        objects = [GroupObject("Data"), ChannelObject("Data", "x_mm", x, {**wave, "unit_string": "mm"}),
+                   ChannelObject("Data", "F_kN", force, {**wave, "unit_string": "kN"})]
+        side = side.replace(f"sample_rate_hz = {FS}\n", "")
+    elif layout == "time channel":
+        objects = [GroupObject("Data"), ChannelObject("Data", "t", t, {"unit_string": "s"}),
+                   ChannelObject("Data", "x_mm", x), ChannelObject("Data", "F_kN", force)]
+    else:
+        objects = [ChannelObject("Shaker", "F_kN", force, {**wave, "unit_string": "kN"}),
+                   ChannelObject("Laser", "x_mm", x, {**wave, "unit_string": "mm"}),
+                   ChannelObject("Spare", "x_mm", -x, {**wave, "unit_string": "mm"})]
+        side = side.replace("x_mm =", '"Laser/x_mm" =')
+    csv.unlink()
+    path = csv.with_suffix(".tdms")
+    with TdmsWriter(str(path)) as w:
+        w.write_segment(objects)
+    path.with_suffix(".toml").write_text(side)
+    return path, twin
+
+
+@pytest.mark.parametrize("layout", ["waveforms", "time channel", "groups"])
+def test_an_ni_tdms_file_reads_to_the_numbers_of_its_csv_twin(tmp_path, layout):
+    path, twin = _tdms_twin(tmp_path, layout)
+    m = read_measurement(path)
+    key = "Laser/x_mm" if layout == "groups" else "x_mm"
+    assert m.sample_rate_hz == pytest.approx(FS, rel=1e-12) and np.max(np.abs(m.t - twin.t)) < 1e-9
+    assert np.array_equal(m.values[key], twin.values["x_mm"]) and np.array_equal(m.values["F_kN"], twin.values["F_kN"])
+    items, _ = read_dataset_with_order(tmp_path)
+    assert [i.path.name for i in items] == ["run.tdms"]
+
+
+def _tdms_by_the_spec(path: pathlib.Path, group: str, channels: dict[str, tuple[np.ndarray, dict]]) -> None:
+    """One TDMS segment written byte by byte from NI's description of the format ('TDMS File Format Internal
+    Structure'), not by the library the reader uses: a lead-in (tag 'TDSm', table of contents: metadata, new
+    object list, raw data; version 4713; the segment's and the metadata's lengths), the objects ('/', the group,
+    its channels) with their raw data index (float64 = type 10, one dimension, the number of values) and
+    properties (float64 values, or strings = type 0x20), then each channel's samples, little-endian."""
+    import struct
+
+    def text(s: str) -> bytes:
+        b = s.encode()
+        return struct.pack("<I", len(b)) + b
+
+    def props(d: dict) -> bytes:
+        out = struct.pack("<I", len(d))
+        for k, v in d.items():
+            out += text(k) + (struct.pack("<I", 0x20) + text(v) if isinstance(v, str) else struct.pack("<Id", 10, v))
+        return out
+
+    meta = struct.pack("<I", 2 + len(channels)) + text("/") + struct.pack("<I", 0xFFFFFFFF) + props({})
+    meta += text(f"/'{group}'") + struct.pack("<I", 0xFFFFFFFF) + props({})
+    raw = b""
+    for name, (data, p) in channels.items():
+        meta += text(f"/'{group}'/'{name}'") + struct.pack("<IIIQ", 20, 10, 1, len(data)) + props(p)
+        raw += np.asarray(data, "<f8").tobytes()
+    lead = b"TDSm" + struct.pack("<iiQQ", 2 | 4 | 8, 4713, len(meta) + len(raw), len(meta))
+    path.write_bytes(lead + meta + raw)
+
+
+def test_a_tdms_file_written_from_ni_s_description_of_the_format_is_read(tmp_path):
+    """A file whose bytes follow NI's format description (not npTDMS's writer): its waveform timing gives the
+    record's time (offset 0.25 s, 1 kHz), its unit_string is checked, its samples read to SI."""
+    x, force = np.sin(np.arange(2000) / 50.0), np.cos(np.arange(2000) / 50.0)
+    wave = {"wf_increment": 1e-3, "wf_start_offset": 0.25}
+    path = tmp_path / "shaker.tdms"
+    _tdms_by_the_spec(path, "Untitled", {"Laser": (x, {**wave, "unit_string": "mm"}),
+                                         "Force": (force, {**wave, "unit_string": "kN"})})
+    path.with_suffix(".toml").write_text('model = "SDOFBoucWen"\n[inputs]\nForce = { unit = "kN", model_variable = '
+                                         '"u" }\n[outputs]\nLaser = { unit = "mm", model_variable = "y" }\n')
+    m = read_measurement(path)
+    assert m.sample_rate_hz == pytest.approx(1000.0, rel=1e-12) and np.max(np.abs(m.t - (0.25 + np.arange(2000) / 1000.0))) < 1e-12
+    assert np.array_equal(m.values["Laser"], x * 1e-3) and np.array_equal(m.values["Force"], force * 1e3)
+    path.with_suffix(".toml").write_text(path.with_suffix(".toml").read_text().replace('"mm"', '"m"'))
+    with pytest.raises(MeasurementError, match=r"channel 'Laser' has unit_string 'mm' but shaker.toml says 'm'"):
+        read_measurement(path)
+    path.with_suffix(".toml").write_text('time_unit = "clock"\n' + path.with_suffix(".toml").read_text())
+    with pytest.raises(MeasurementError, match=r"\[time_unit\] 'clock' for shaker.tdms: clock stamps are text"):
+        read_measurement(path)
+
+
+def test_an_ni_tdms_file_that_cannot_be_used_is_refused_naming_the_fix(tmp_path):
+    """Each refusal names the file, the channel and what is allowed: a channel named ambiguously (two groups hold
+    it) or not at all, a unit_string the sidecar contradicts, waveforms of different timing, a stated rate the
+    waveforms contradict, and a file that is not TDMS."""
+    from nptdms import ChannelObject, TdmsWriter
+
+    path, _ = _tdms_twin(tmp_path, "groups")
+    side = path.with_suffix(".toml")
+    groups = side.read_text()
+    side.write_text(groups.replace('"Laser/x_mm" =', "x_mm ="))
+    with pytest.raises(MeasurementError, match=r"run.tdms: channel 'x_mm' named in run.toml is in several groups "
+                                               r"\(Laser/x_mm, Spare/x_mm\); allowed: the channel named as "
+                                               r"'group/channel'"):
+        read_measurement(path)
+    side.write_text(groups.replace('"Laser/x_mm" =', '"Laser/x" ='))
+    with pytest.raises(MeasurementError, match=r"run.tdms: channel 'Laser/x' named in run.toml is missing; channels: "
+                                               r"(?=.*Shaker/F_kN)(?=.*Laser/x_mm).*; allowed: a TDMS file"):
+        read_measurement(path)
+    side.write_text(groups.replace('unit = "mm"', 'unit = "um"'))
+    with pytest.raises(MeasurementError, match=r"channel 'Laser/x_mm' has unit_string 'mm' but run.toml says 'um'"):
+        read_measurement(path)
+    side.write_text(groups.replace("sample_rate_hz = 750.0", "sample_rate_hz = 1000.0"))
+    with pytest.raises(MeasurementError, match=r"\[sample_rate_hz\] = 1000 but column '\(wf_increment\)' is sampled "
+                                               r"at 750 Hz"):
+        read_measurement(path)
+    side.write_text(groups)
+    x = np.zeros(N)
+    with TdmsWriter(str(path)) as w:
+        w.write_segment([ChannelObject("Shaker", "F_kN", x, {"wf_increment": 1 / FS}),
+                         ChannelObject("Laser", "x_mm", x, {"wf_increment": 1 / (2 * FS)})])
+    with pytest.raises(MeasurementError, match=r"run.tdms: the used channels' waveform timings differ"):
+        read_measurement(path)
+    path.write_bytes(b"t,x_mm\n0,1\n" * 30)
+    with pytest.raises(MeasurementError, match=r"run.tdms: not readable as a TDMS file"):
+        read_measurement(path)
+
+
 def test_a_file_holding_several_levels_reads_as_one_measurement_per_segment(tmp_path):
     """Three levels recorded one after the other in one file, cut by the sidecar's [[segments]]: each segment
     reads to the numbers of the level written in a file of its own, under the name 'file#k', its level and

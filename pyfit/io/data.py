@@ -1,6 +1,7 @@
 """Measurement files (theory §5): a CSV (or .txt, .dat, .tsv, .asc; any case) plus a TOML sidecar of the same stem,
 or a MATLAB .mat file (any format, v4 to v7.3: pyfit.io.matlab) whose vectors, a struct's fields ('s.x') or one matrix's
-columns (named by the sidecar's `columns`) are the columns.
+columns (named by the sidecar's `columns`) are the columns, or an NI TDMS file (pyfit.io.tdms) whose channels
+('group/channel', or the channel's name where unique) are, timed by their waveform properties.
 
 Sidecar keys: model, sample_rate_hz (optional where the file has a time column: its rate, rate_of), [inputs]
 and [outputs] mapping column -> {unit, model_variable[, weight, sensitivity, invert]} (sensitivity: a voltage
@@ -53,6 +54,7 @@ import numpy as np
 
 from pyfit.io.matlab import MatlabFileError, mat_variables
 from pyfit.io.schema import ConfigError, check_table, fail, read_text, read_toml
+from pyfit.io.tdms import TdmsFileError, tdms_channels
 from pyfit.io.units import FOOT, G0, INCH, NUMBER, POUND, parse_unit
 
 TO_SI = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": INCH, "ft": FOOT, "rad": 1.0, "deg": np.pi / 180,
@@ -479,17 +481,23 @@ MAT_ALLOWED = ("a MATLAB file (v4, v6, v7 or v7.3) holding the columns as vector
                "struct ('s.x'), or as the columns of one matrix the sidecar's `columns` names")
 
 
+def _opened(path: pathlib.Path, side: pathlib.Path, meta: dict, read, error: type, kind: str, allowed: str):
+    """A binary measurement file's content as `read` gives it (its `error` refused as not a `kind` file); a
+    sidecar asking for clock stamps, which only text holds, refused."""
+    if meta["time_unit"] == CLOCK:
+        fail(side, "time_unit", f"'{CLOCK}' for {path.name}: clock stamps are text", f"s or ms for a {kind} file's "
+             "time", MeasurementError)
+    try:
+        return read(path)
+    except error as exc:
+        raise MeasurementError(f"{path}: not readable as a {kind} file ({exc}); allowed: {allowed}") from exc
+
+
 def _mat_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
     """The used columns of a MATLAB file (pyfit.io.matlab), as _text_columns gives a text file's: vectors by
     their names, a struct's fields as 'struct.field', or the columns (or rows) of the one matrix whose size
     matches the sidecar's `columns`, by those names."""
-    if meta["time_unit"] == CLOCK:
-        fail(side, "time_unit", f"'{CLOCK}' for {path.name}: clock stamps are text", "s or ms for a MATLAB file's "
-             "time vector", MeasurementError)
-    try:
-        arrays = mat_variables(path)
-    except MatlabFileError as exc:
-        raise MeasurementError(f"{path}: not readable as a MATLAB file ({exc}); allowed: {MAT_ALLOWED}") from exc
+    arrays = _opened(path, side, meta, mat_variables, MatlabFileError, "MATLAB", MAT_ALLOWED)
     if meta["columns"] is not None:
         k = len(meta["columns"])
         matrices = [n for n, a in arrays.items() if a.ndim == 2 and k in a.shape]
@@ -500,17 +508,62 @@ def _mat_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: d
         vectors = dict(zip(meta["columns"], (m if m.shape[1] == k else m.T).T))
     else:
         vectors = {n: a for n, a in arrays.items() if a.ndim == 1}
+    return _used_vectors(path, side, meta, channels, vectors, ("variable", "vectors"), MAT_ALLOWED)
+
+
+def _used_vectors(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel],
+                  vectors: dict[str, np.ndarray], nouns: tuple[str, str], allowed: str):
+    """The time vector (when the file holds meta's time_column) and the used channels of a binary file's
+    vectors, each at least two samples and all of one length, as _text_columns gives a text file's columns;
+    `nouns`: what the file calls one and what the vectors are listed as in a refusal."""
+    noun, listed = nouns
     time_col = meta["time_column"] if meta["time_column"] in vectors else None
     used = ([time_col] if time_col else []) + list(channels)
     for name in used:
         if name not in vectors:
-            raise MeasurementError(f"{path}: variable '{name}' named in {side.name} is missing; vectors: "
-                                   f"{', '.join(vectors) or 'none'}; allowed: {MAT_ALLOWED}")
+            raise MeasurementError(f"{path}: {noun} '{name}' named in {side.name} is missing; {listed}: "
+                                   f"{', '.join(vectors) or 'none'}; allowed: {allowed}")
     lengths = {name: len(vectors[name]) for name in used}
     if len(set(lengths.values())) > 1 or min(lengths.values()) < 2:
-        raise MeasurementError(f"{path}: the used vectors differ in length or hold fewer than two samples "
-                               f"({', '.join(f'{n}: {k}' for n, k in lengths.items())}); allowed: {MAT_ALLOWED}")
-    return {name: vectors[name].astype(float) for name in used}, time_col, 0
+        raise MeasurementError(f"{path}: the used {noun}s differ in length or hold fewer than two samples "
+                               f"({', '.join(f'{n}: {k}' for n, k in lengths.items())}); allowed: {allowed}")
+    return {name: np.array(vectors[name], float) for name in used}, time_col, 0
+
+
+TDMS_ALLOWED = ("a TDMS file whose used channels (named 'group/channel', or by the channel's name where no other "
+                "group holds one of that name) are numeric, of one length and, as waveforms, of one wf_increment")
+WAVEFORM_TIME = "(wf_increment)"  # the name of the time a TDMS file's waveform timing gives, in messages
+
+
+def _tdms_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
+    """The used channels of an NI TDMS file (pyfit.io.tdms), as _text_columns gives a text file's columns: a
+    channel's unit_string, where it names a known unit, must be the sidecar's; without a time channel the time
+    is the waveforms' own (wf_start_offset + k wf_increment), which a stated sample_rate_hz must agree with."""
+    found = _opened(path, side, meta, tdms_channels, TdmsFileError, "TDMS", TDMS_ALLOWED)
+    for name in channels:
+        groups = [n for n in found if n.endswith(f"/{name}")]
+        if name not in found and len(groups) > 1:
+            raise MeasurementError(f"{path}: channel '{name}' named in {side.name} is in several groups "
+                                   f"({', '.join(groups)}); allowed: the channel named as 'group/channel'")
+    cols, time_col, skip = _used_vectors(path, side, meta, channels, {n: c.data for n, c in found.items()},
+                                         ("channel", "channels"), TDMS_ALLOWED)
+    for name, ch in channels.items():
+        written = unit_key(found[name].unit)
+        if written in TO_SI and written != ch.unit:
+            raise MeasurementError(f"{path}: channel '{name}' has unit_string '{found[name].unit}' but {side.name} "
+                                   f"says '{ch.unit}'; allowed: the same unit in both")
+    if time_col is None:
+        timing = {n: (found[n].increment_s, found[n].offset_s) for n in channels}
+        if len(set(timing.values())) > 1:
+            listed = ", ".join(f"{n}: {dt} s, {t0:g} s" for n, (dt, t0) in timing.items())
+            raise MeasurementError(f"{path}: the used channels' waveform timings differ (wf_increment, "
+                                   f"wf_start_offset: {listed}); allowed: {TDMS_ALLOWED}")
+        increment, offset = next(iter(timing.values()))
+        if increment is not None:  # in the sidecar's time unit, as a time channel is
+            n = len(next(iter(cols.values())))
+            cols = {WAVEFORM_TIME: (offset + np.arange(n) * increment) / TIME_UNITS[meta["time_unit"]], **cols}
+            time_col = WAVEFORM_TIME
+    return cols, time_col, skip
 
 
 def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
@@ -533,7 +586,7 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
         fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join((*TIME_UNITS, CLOCK)), MeasurementError)
     inputs = _channels(side, meta["inputs"], "inputs")
     outputs = _channels(side, meta["outputs"], "outputs")
-    read = _mat_columns if csv_path.suffix.lower() == ".mat" else _text_columns
+    read = {".mat": _mat_columns, ".tdms": _tdms_columns}.get(csv_path.suffix.lower(), _text_columns)
     cols, time_col, skip = read(csv_path, side, meta, {**inputs, **outputs})
     n = len(next(iter(cols.values())))
     if fs is None and not time_col:
@@ -698,7 +751,7 @@ def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool
     return volts
 
 
-DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc", ".mat")  # a measurement file's extensions, in any case
+DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc", ".mat", ".tdms")  # a measurement file's extensions, in any case
 
 
 def measurement_files(folder: str | pathlib.Path) -> list[pathlib.Path]:
