@@ -591,7 +591,7 @@ def test_a_tdms_file_written_from_ni_s_description_of_the_format_is_read(tmp_pat
     assert m.sample_rate_hz == pytest.approx(1000.0, rel=1e-12) and np.max(np.abs(m.t - (0.25 + np.arange(2000) / 1000.0))) < 1e-12
     assert np.array_equal(m.values["Laser"], x * 1e-3) and np.array_equal(m.values["Force"], force * 1e3)
     path.with_suffix(".toml").write_text(path.with_suffix(".toml").read_text().replace('"mm"', '"m"'))
-    with pytest.raises(MeasurementError, match=r"channel 'Laser' has unit_string 'mm' but shaker.toml says 'm'"):
+    with pytest.raises(MeasurementError, match=r"channel 'Laser' has the unit 'mm' but shaker.toml says 'm'"):
         read_measurement(path)
     path.with_suffix(".toml").write_text('time_unit = "clock"\n' + path.with_suffix(".toml").read_text())
     with pytest.raises(MeasurementError, match=r"\[time_unit\] 'clock' for shaker.tdms: clock stamps are text"):
@@ -608,19 +608,18 @@ def test_an_ni_tdms_file_that_cannot_be_used_is_refused_naming_the_fix(tmp_path)
     side = path.with_suffix(".toml")
     groups = side.read_text()
     side.write_text(groups.replace('"Laser/x_mm" =', "x_mm ="))
-    with pytest.raises(MeasurementError, match=r"run.tdms: channel 'x_mm' named in run.toml is in several groups "
-                                               r"\(Laser/x_mm, Spare/x_mm\); allowed: the channel named as "
-                                               r"'group/channel'"):
+    with pytest.raises(MeasurementError, match=r"run.tdms: channel 'x_mm' named in run.toml names several channels "
+                                               r"\(Laser/x_mm, Spare/x_mm\); allowed: one of those names"):
         read_measurement(path)
     side.write_text(groups.replace('"Laser/x_mm" =', '"Laser/x" ='))
     with pytest.raises(MeasurementError, match=r"run.tdms: channel 'Laser/x' named in run.toml is missing; channels: "
                                                r"(?=.*Shaker/F_kN)(?=.*Laser/x_mm).*; allowed: a TDMS file"):
         read_measurement(path)
     side.write_text(groups.replace('unit = "mm"', 'unit = "um"'))
-    with pytest.raises(MeasurementError, match=r"channel 'Laser/x_mm' has unit_string 'mm' but run.toml says 'um'"):
+    with pytest.raises(MeasurementError, match=r"channel 'Laser/x_mm' has the unit 'mm' but run.toml says 'um'"):
         read_measurement(path)
     side.write_text(groups.replace("sample_rate_hz = 750.0", "sample_rate_hz = 1000.0"))
-    with pytest.raises(MeasurementError, match=r"\[sample_rate_hz\] = 1000 but column '\(wf_increment\)' is sampled "
+    with pytest.raises(MeasurementError, match=r"\[sample_rate_hz\] = 1000 but column '\(waveform timing\)' is sampled "
                                                r"at 750 Hz"):
         read_measurement(path)
     side.write_text(groups)
@@ -628,11 +627,91 @@ def test_an_ni_tdms_file_that_cannot_be_used_is_refused_naming_the_fix(tmp_path)
     with TdmsWriter(str(path)) as w:
         w.write_segment([ChannelObject("Shaker", "F_kN", x, {"wf_increment": 1 / FS}),
                          ChannelObject("Laser", "x_mm", x, {"wf_increment": 1 / (2 * FS)})])
-    with pytest.raises(MeasurementError, match=r"run.tdms: the used channels' waveform timings differ"):
+    with pytest.raises(MeasurementError, match=r"run.tdms: the used channels' timings differ"):
         read_measurement(path)
     path.write_bytes(b"t,x_mm\n0,1\n" * 30)
     with pytest.raises(MeasurementError, match=r"run.tdms: not readable as a TDMS file"):
         read_measurement(path)
+
+
+def _uff58(id1: str, node: int, direction: int, unit: str, data: np.ndarray, dt: float, t0: float = 0.0,
+           spec: int = 8, function: int = 1, abscissa: int = 17) -> str:
+    """One time record (universal dataset 58, ASCII, real double) written line by line from the format's
+    description, not by the library the reader uses: the delimiters, five ID lines, the DOF identification
+    (`function` type, 1: time response; the response node and direction), the data form (type 4, even spacing,
+    abscissa start and increment), the abscissa (specific data type `abscissa`, 17: time) and ordinate (`spec`,
+    its unit label) characteristics, then the values four to a line (E20.12)."""
+    lines = ["    -1", "    58", id1, "NONE", "NONE", "NONE", "NONE",
+             f"{function:5d}{0:10d}{0:5d}{0:10d} {'NONE':10s}{node:10d}{direction:4d} {'NONE':10s}{0:10d}{0:4d}",
+             f"{4:10d}{len(data):10d}{1:10d}{t0:13.5e}{dt:13.5e}{0.0:13.5e}",
+             f"{abscissa:10d}{0:5d}{0:5d}{0:5d} {'NONE':20s} {'NONE':20s}",
+             f"{spec:10d}{0:5d}{0:5d}{0:5d} {'NONE':20s} {unit:20s}",
+             f"{0:10d}{0:5d}{0:5d}{0:5d} {'NONE':20s} {'NONE':20s}",
+             f"{0:10d}{0:5d}{0:5d}{0:5d} {'NONE':20s} {'NONE':20s}"]
+    lines += ["".join(f"{v:20.12e}" for v in data[i:i + 4]) for i in range(0, len(data), 4)]
+    return "\n".join(lines + ["    -1"]) + "\n"
+
+
+def test_a_universal_file_s_time_records_read_to_the_numbers_of_their_csv_twin(tmp_path):
+    """A universal file (dataset 58) holding the CSV twin's force and displacement as time records, written
+    from the format's description (a records' writer of our own in the test, not pyuff's), with an FRF record
+    beside them that is not a channel: read by id1 and by 'node:direction', timed by the abscissa increment (no
+    sample_rate_hz), the units checked; a record whose name another shares is refused naming both."""
+    csv = lab_file(tmp_path, "run")
+    twin = read_measurement(csv)
+    t, x, force = np.loadtxt(csv, delimiter=",", skiprows=3, usecols=(0, 1, 2)).T
+    side = csv.with_suffix(".toml").read_text().replace(f"sample_rate_hz = {FS}\n", "")
+    csv.unlink()
+    frf = _uff58("H 101:+Z/1:+Z", 101, 3, "mm/kN", np.ones(8), 1.0, function=4, abscissa=18)  # an FRF over Hz
+    path = tmp_path / "run.uff"
+    path.write_text(_uff58("F_kN", 1, 3, "kN", force, 1 / FS, spec=13) + _uff58("Laser", 101, 3, "mm", x, 1 / FS)
+                    + frf)
+    side_file = path.with_suffix(".toml")
+    side_file.write_text(side.replace("x_mm =", '"101:+Z" ='))
+    m = read_measurement(path)
+    assert m.sample_rate_hz == pytest.approx(FS, rel=1e-12) and np.max(np.abs(m.t - twin.t)) < 1e-9
+    assert np.allclose(m.values["101:+Z"], twin.values["x_mm"], rtol=1e-11, atol=0)  # 12 digits written
+    assert np.allclose(m.values["F_kN"], twin.values["F_kN"], rtol=1e-11, atol=0)
+    side_file.write_text(side.replace("x_mm =", "Laser =").replace('unit = "mm"', 'unit = "m"'))
+    with pytest.raises(MeasurementError, match=r"run.uff: channel 'Laser' has the unit 'mm' but run.toml says 'm'"):
+        read_measurement(path)
+    path.write_text(path.read_text() + _uff58("Laser", 102, 3, "mm", x, 1 / FS))
+    side_file.write_text(side.replace("x_mm =", "Laser ="))
+    with pytest.raises(MeasurementError, match=r"run.uff: channel 'Laser' named in run.toml names several channels "
+                                               r"\(#2, #4\)"):
+        read_measurement(path)
+    side_file.write_text(side.replace("x_mm =", '"#4" ='))
+    assert np.allclose(read_measurement(path).values["#4"], twin.values["x_mm"], rtol=1e-11, atol=0)
+
+
+@pytest.mark.parametrize("rate", [750.0, 1000.0, 1651.2, 2048.0, 2560.0, 8192.0, 12800.0, 25600.0, 48000.0, 51200.0])
+def test_a_universal_file_s_six_digit_increment_gives_the_rate_the_daq_was_set_to(rate):
+    from pyfit.io.uff import increment_of
+
+    written = float(f"{1 / rate:.5e}")  # the header's E13.5
+    assert increment_of(written) == pytest.approx(1 / rate, rel=1e-15)
+
+
+def test_a_universal_file_written_by_pyuff_is_read(tmp_path):
+    """The same records as pyuff writes them (another writer's layout of dataset 58): id1 names the channels."""
+    import pyuff
+
+    t = np.arange(3000) / 2048.0
+    a, f = np.sin(2 * np.pi * 30 * t), np.cos(2 * np.pi * 30 * t)
+    common = dict(func_type=1, ref_node=0, ref_dir=0, abscissa_spacing=1, abscissa_min=0.5, abscissa_inc=1 / 2048.0, x=0.5 + t,
+                  abscissa_spec_data_type=17, abscissa_axis_units_lab="s", orddenom_spec_data_type=0,
+                  z_axis_spec_data_type=0, binary=0)
+    sets = [pyuff.prepare_58(id1="acc_mass", rsp_node=2, rsp_dir=-3, data=a, ordinate_axis_units_lab="g",
+                             ordinate_spec_data_type=12, **common),
+            pyuff.prepare_58(id1="clamp_force", rsp_node=1, rsp_dir=3, data=f, ordinate_axis_units_lab="N",
+                             ordinate_spec_data_type=13, **common)]
+    path = tmp_path / "sweep.unv"
+    pyuff.UFF(str(path)).write_sets(sets, mode="overwrite")
+    path.with_suffix(".toml").write_text('model = "SDOFBoucWen"\n[inputs]\nclamp_force = { unit = "N", model_variable '
+                                         '= "u" }\n[outputs]\n"2:-Z" = { unit = "g", model_variable = "y" }\n')
+    m = read_measurement(path)
+    assert m.sample_rate_hz == pytest.approx(2048.0, rel=1e-12) and m.t[0] == pytest.approx(0.5, abs=1e-12)
+    assert np.allclose(m.values["2:-Z"], a * 9.80665, rtol=1e-10, atol=1e-12) and np.allclose(m.values["clamp_force"], f)
 
 
 def test_a_file_holding_several_levels_reads_as_one_measurement_per_segment(tmp_path):

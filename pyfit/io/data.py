@@ -1,7 +1,8 @@
 """Measurement files (theory §5): a CSV (or .txt, .dat, .tsv, .asc; any case) plus a TOML sidecar of the same stem,
 or a MATLAB .mat file (any format, v4 to v7.3: pyfit.io.matlab) whose vectors, a struct's fields ('s.x') or one matrix's
 columns (named by the sidecar's `columns`) are the columns, or an NI TDMS file (pyfit.io.tdms) whose channels
-('group/channel', or the channel's name where unique) are, timed by their waveform properties.
+('group/channel', or the channel's name where unique) are, timed by their waveform properties, or a universal file
+(.uff, .unv; pyfit.io.uff) whose time records (dataset 58) are.
 
 Sidecar keys: model, sample_rate_hz (optional where the file has a time column: its rate, rate_of), [inputs]
 and [outputs] mapping column -> {unit, model_variable[, weight, sensitivity, invert]} (sensitivity: a voltage
@@ -55,6 +56,7 @@ import numpy as np
 from pyfit.io.matlab import MatlabFileError, mat_variables
 from pyfit.io.schema import ConfigError, check_table, fail, read_text, read_toml
 from pyfit.io.tdms import TdmsFileError, tdms_channels
+from pyfit.io.uff import UffFileError, uff_channels
 from pyfit.io.units import FOOT, G0, INCH, NUMBER, POUND, parse_unit
 
 TO_SI = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": INCH, "ft": FOOT, "rad": 1.0, "deg": np.pi / 180,
@@ -532,38 +534,54 @@ def _used_vectors(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: 
 
 TDMS_ALLOWED = ("a TDMS file whose used channels (named 'group/channel', or by the channel's name where no other "
                 "group holds one of that name) are numeric, of one length and, as waveforms, of one wf_increment")
-WAVEFORM_TIME = "(wf_increment)"  # the name of the time a TDMS file's waveform timing gives, in messages
+UFF_ALLOWED = ("a universal file whose used channels are time records of dataset 58 (real, evenly spaced), named "
+               "'#k' (the k-th record), by id1 or as 'node:direction' ('101:+Z') where no other record holds the name,"
+               " of one length and one abscissa increment")
+WAVEFORM_TIME = "(waveform timing)"  # the name of the time a file's waveform timing gives, in messages
 
 
-def _tdms_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
-    """The used channels of an NI TDMS file (pyfit.io.tdms), as _text_columns gives a text file's columns: a
-    channel's unit_string, where it names a known unit, must be the sidecar's; without a time channel the time
-    is the waveforms' own (wf_start_offset + k wf_increment), which a stated sample_rate_hz must agree with."""
-    found = _opened(path, side, meta, tdms_channels, TdmsFileError, "TDMS", TDMS_ALLOWED)
+def _waveform_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel],
+                      read, error: type, kind: str, allowed: str):
+    """The used channels of a file whose channels carry their own timing (pyfit.io.waveform: NI TDMS, universal
+    file dataset 58), as _text_columns gives a text file's columns: a channel's unit, where the file names a
+    known one, must be the sidecar's; without a time channel the time is the waveforms' own (offset + k
+    increment), which a stated sample_rate_hz must agree with."""
+    named = _opened(path, side, meta, read, error, kind, allowed)
+    found = named.channels
     for name in channels:
-        groups = [n for n in found if n.endswith(f"/{name}")]
-        if name not in found and len(groups) > 1:
-            raise MeasurementError(f"{path}: channel '{name}' named in {side.name} is in several groups "
-                                   f"({', '.join(groups)}); allowed: the channel named as 'group/channel'")
+        if name in named.ambiguous:
+            raise MeasurementError(f"{path}: channel '{name}' named in {side.name} names several channels "
+                                   f"({', '.join(named.ambiguous[name])}); allowed: one of those names")
     cols, time_col, skip = _used_vectors(path, side, meta, channels, {n: c.data for n, c in found.items()},
-                                         ("channel", "channels"), TDMS_ALLOWED)
+                                         ("channel", "channels"), allowed)
     for name, ch in channels.items():
         written = unit_key(found[name].unit)
         if written in TO_SI and written != ch.unit:
-            raise MeasurementError(f"{path}: channel '{name}' has unit_string '{found[name].unit}' but {side.name} "
+            raise MeasurementError(f"{path}: channel '{name}' has the unit '{found[name].unit}' but {side.name} "
                                    f"says '{ch.unit}'; allowed: the same unit in both")
     if time_col is None:
         timing = {n: (found[n].increment_s, found[n].offset_s) for n in channels}
         if len(set(timing.values())) > 1:
             listed = ", ".join(f"{n}: {dt} s, {t0:g} s" for n, (dt, t0) in timing.items())
-            raise MeasurementError(f"{path}: the used channels' waveform timings differ (wf_increment, "
-                                   f"wf_start_offset: {listed}); allowed: {TDMS_ALLOWED}")
+            raise MeasurementError(f"{path}: the used channels' timings differ (increment, start: {listed}); "
+                                   f"allowed: {allowed}")
         increment, offset = next(iter(timing.values()))
         if increment is not None:  # in the sidecar's time unit, as a time channel is
             n = len(next(iter(cols.values())))
             cols = {WAVEFORM_TIME: (offset + np.arange(n) * increment) / TIME_UNITS[meta["time_unit"]], **cols}
             time_col = WAVEFORM_TIME
     return cols, time_col, skip
+
+
+def _tdms_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
+    """The used channels of an NI TDMS file (pyfit.io.tdms): _waveform_columns."""
+    return _waveform_columns(path, side, meta, channels, tdms_channels, TdmsFileError, "TDMS", TDMS_ALLOWED)
+
+
+def _uff_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
+    """The used time records of a universal file (pyfit.io.uff): _waveform_columns."""
+    return _waveform_columns(path, side, meta, channels, uff_channels, UffFileError, "universal (UFF 58)",
+                             UFF_ALLOWED)
 
 
 def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
@@ -586,7 +604,8 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
         fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join((*TIME_UNITS, CLOCK)), MeasurementError)
     inputs = _channels(side, meta["inputs"], "inputs")
     outputs = _channels(side, meta["outputs"], "outputs")
-    read = {".mat": _mat_columns, ".tdms": _tdms_columns}.get(csv_path.suffix.lower(), _text_columns)
+    read = {".mat": _mat_columns, ".tdms": _tdms_columns, ".uff": _uff_columns, ".unv": _uff_columns}.get(
+        csv_path.suffix.lower(), _text_columns)
     cols, time_col, skip = read(csv_path, side, meta, {**inputs, **outputs})
     n = len(next(iter(cols.values())))
     if fs is None and not time_col:
@@ -751,7 +770,7 @@ def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool
     return volts
 
 
-DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc", ".mat", ".tdms")  # a measurement file's extensions, in any case
+DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc", ".mat", ".tdms", ".uff", ".unv")  # a measurement file's extensions, in any case
 
 
 def measurement_files(folder: str | pathlib.Path) -> list[pathlib.Path]:
