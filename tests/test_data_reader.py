@@ -693,7 +693,8 @@ def test_a_universal_file_s_six_digit_increment_gives_the_rate_the_daq_was_set_t
 
 
 def test_a_universal_file_written_by_pyuff_is_read(tmp_path):
-    """The same records as pyuff writes them (another writer's layout of dataset 58): id1 names the channels."""
+    """Records as pyuff writes them (another writer's layout of dataset 58): by id1 and by node and direction,
+    the start of the abscissa kept, accelerations in g read to m/s²."""
     import pyuff
 
     t = np.arange(3000) / 2048.0
