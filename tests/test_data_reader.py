@@ -588,7 +588,8 @@ def test_a_tdms_file_written_from_ni_s_description_of_the_format_is_read(tmp_pat
     path.with_suffix(".toml").write_text('model = "SDOFBoucWen"\n[inputs]\nForce = { unit = "kN", model_variable = '
                                          '"u" }\n[outputs]\nLaser = { unit = "mm", model_variable = "y" }\n')
     m = read_measurement(path)
-    assert m.sample_rate_hz == pytest.approx(1000.0, rel=1e-12) and np.max(np.abs(m.t - (0.25 + np.arange(2000) / 1000.0))) < 1e-12
+    assert m.sample_rate_hz == pytest.approx(1000.0, rel=1e-12)
+    assert np.max(np.abs(m.t - (0.25 + np.arange(2000) / 1000.0))) < 1e-12
     assert np.array_equal(m.values["Laser"], x * 1e-3) and np.array_equal(m.values["Force"], force * 1e3)
     path.with_suffix(".toml").write_text(path.with_suffix(".toml").read_text().replace('"mm"', '"m"'))
     with pytest.raises(MeasurementError, match=r"channel 'Laser' has the unit 'mm' but shaker.toml says 'm'"):
@@ -699,7 +700,8 @@ def test_a_universal_file_written_by_pyuff_is_read(tmp_path):
 
     t = np.arange(3000) / 2048.0
     a, f = np.sin(2 * np.pi * 30 * t), np.cos(2 * np.pi * 30 * t)
-    common = dict(func_type=1, ref_node=0, ref_dir=0, abscissa_spacing=1, abscissa_min=0.5, abscissa_inc=1 / 2048.0, x=0.5 + t,
+    common = dict(func_type=1, ref_node=0, ref_dir=0, abscissa_spacing=1, abscissa_min=0.5, abscissa_inc=1 / 2048.0,
+                  x=0.5 + t,
                   abscissa_spec_data_type=17, abscissa_axis_units_lab="s", orddenom_spec_data_type=0,
                   z_axis_spec_data_type=0, binary=0)
     sets = [pyuff.prepare_58(id1="acc_mass", rsp_node=2, rsp_dir=-3, data=a, ordinate_axis_units_lab="g",
@@ -712,7 +714,8 @@ def test_a_universal_file_written_by_pyuff_is_read(tmp_path):
                                          '= "u" }\n[outputs]\n"2:-Z" = { unit = "g", model_variable = "y" }\n')
     m = read_measurement(path)
     assert m.sample_rate_hz == pytest.approx(2048.0, rel=1e-12) and m.t[0] == pytest.approx(0.5, abs=1e-12)
-    assert np.allclose(m.values["2:-Z"], a * 9.80665, rtol=1e-10, atol=1e-12) and np.allclose(m.values["clamp_force"], f)
+    assert np.allclose(m.values["2:-Z"], a * 9.80665, rtol=1e-10, atol=1e-12)  # g is standard gravity here
+    assert np.allclose(m.values["clamp_force"], f, rtol=1e-10, atol=1e-12)
 
 
 def test_a_file_holding_several_levels_reads_as_one_measurement_per_segment(tmp_path):

@@ -1,6 +1,6 @@
 """Measurement files (theory §5): a CSV (or .txt, .dat, .tsv, .asc; any case) plus a TOML sidecar of the same stem,
-or a MATLAB .mat file (any format, v4 to v7.3: pyfit.io.matlab) whose vectors, a struct's fields ('s.x') or one matrix's
-columns (named by the sidecar's `columns`) are the columns, or an NI TDMS file (pyfit.io.tdms) whose channels
+or a MATLAB .mat file (any format, v4 to v7.3: pyfit.io.matlab) whose vectors, a struct's fields ('s.x') or one
+matrix's columns (named by the sidecar's `columns`) are the columns, or an NI TDMS file (pyfit.io.tdms) whose channels
 ('group/channel', or the channel's name where unique) are, timed by their waveform properties, or a universal file
 (.uff, .unv; pyfit.io.uff) whose time records (dataset 58) are.
 
@@ -770,7 +770,8 @@ def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool
     return volts
 
 
-DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc", ".mat", ".tdms", ".uff", ".unv")  # a measurement file's extensions, in any case
+# a measurement file's extensions, in any case
+DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc", ".mat", ".tdms", ".uff", ".unv")
 
 
 def measurement_files(folder: str | pathlib.Path) -> list[pathlib.Path]:

@@ -18,8 +18,6 @@ TIME_RESPONSE, TIME_ABSCISSA, EVEN = 1, 17, 1  # function type, abscissa specifi
 REAL = (2, 4)  # ordinate data types: real single and double precision (5, 6: complex)
 DIRECTIONS = {0: "S", 1: "+X", 2: "+Y", 3: "+Z", 4: "+RX", 5: "+RY", 6: "+RZ", -1: "-X", -2: "-Y", -3: "-Z",
               -4: "-RX", -5: "-RY", -6: "-RZ"}  # response direction codes (0: a scalar point)
-
-
 INCREMENT_DIGITS = 6  # the abscissa increment's significant digits in the dataset's header (E13.5)
 
 
