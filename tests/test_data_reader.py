@@ -509,7 +509,8 @@ def _tdms_twin(tmp_path, layout: str) -> tuple[pathlib.Path, object]:
     """An NI TDMS file (written by npTDMS's writer) holding the columns of lab_file's CSV as NI DAQ software logs
     them, beside the CSV's sidecar, and the CSV's own reading: 'waveforms' (channels with wf_increment and
     unit_string, no time channel, the sidecar without sample_rate_hz), 'time channel' (a channel 't' beside
-    them, no waveform timing) or 'groups' (a second group holding a channel named as the used displacement:
+    them, no waveform timing), 'timestamps' (a channel of time stamps, the sidecar's time_column, no
+    sample_rate_hz) or 'groups' (a second group holding a channel named as the used displacement:
     the sidecar names it 'Laser/x_mm')."""
     from nptdms import ChannelObject, GroupObject, TdmsWriter
 
@@ -525,6 +526,12 @@ def _tdms_twin(tmp_path, layout: str) -> tuple[pathlib.Path, object]:
     elif layout == "time channel":
         objects = [GroupObject("Data"), ChannelObject("Data", "t", t, {"unit_string": "s"}),
                    ChannelObject("Data", "x_mm", x), ChannelObject("Data", "F_kN", force)]
+    elif layout == "timestamps":  # LabVIEW's time stamps (ns resolution) beside channels without waveform timing
+        start = np.datetime64("2026-05-04T10:15:00", "ns")
+        stamps = start + np.round(np.arange(len(t)) * 1e9 / FS).astype("timedelta64[ns]")
+        objects = [GroupObject("Data"), ChannelObject("Data", "Time", stamps), ChannelObject("Data", "x_mm", x),
+                   ChannelObject("Data", "F_kN", force)]
+        side = 'time_column = "Time"\n' + side.replace(f"sample_rate_hz = {FS}\n", "")
     else:
         objects = [ChannelObject("Shaker", "F_kN", force, {**wave, "unit_string": "kN"}),
                    ChannelObject("Laser", "x_mm", x, {**wave, "unit_string": "mm"}),
@@ -538,12 +545,13 @@ def _tdms_twin(tmp_path, layout: str) -> tuple[pathlib.Path, object]:
     return path, twin
 
 
-@pytest.mark.parametrize("layout", ["waveforms", "time channel", "groups"])
+@pytest.mark.parametrize("layout", ["waveforms", "time channel", "timestamps", "groups"])
 def test_an_ni_tdms_file_reads_to_the_numbers_of_its_csv_twin(tmp_path, layout):
     path, twin = _tdms_twin(tmp_path, layout)
     m = read_measurement(path)
     key = "Laser/x_mm" if layout == "groups" else "x_mm"
-    assert m.sample_rate_hz == pytest.approx(FS, rel=1e-12) and np.max(np.abs(m.t - twin.t)) < 1e-9
+    resolution = 1e-6 if layout == "timestamps" else 1e-9  # npTDMS writes time stamps to the microsecond
+    assert m.sample_rate_hz == pytest.approx(FS, rel=1e-12) and np.max(np.abs(m.t - twin.t)) < resolution
     assert np.array_equal(m.values[key], twin.values["x_mm"]) and np.array_equal(m.values["F_kN"], twin.values["F_kN"])
     items, _ = read_dataset_with_order(tmp_path)
     assert [i.path.name for i in items] == ["run.tdms"]
@@ -553,8 +561,9 @@ def _tdms_by_the_spec(path: pathlib.Path, group: str, channels: dict[str, tuple[
     """One TDMS segment written byte by byte from NI's description of the format ('TDMS File Format Internal
     Structure'), not by the library the reader uses: a lead-in (tag 'TDSm', table of contents: metadata, new
     object list, raw data; version 4713; the segment's and the metadata's lengths), the objects ('/', the group,
-    its channels) with their raw data index (float64 = type 10, one dimension, the number of values) and
-    properties (float64 values, or strings = type 0x20), then each channel's samples, little-endian."""
+    its channels) with their raw data index (float64 = type 10, or time stamps = type 0x44 for a structured
+    array of 'fractions' and 'seconds'; one dimension, the number of values) and properties (float64 values, or
+    strings = type 0x20), then each channel's samples, little-endian."""
     import struct
 
     def text(s: str) -> bytes:
@@ -571,15 +580,18 @@ def _tdms_by_the_spec(path: pathlib.Path, group: str, channels: dict[str, tuple[
     meta += text(f"/'{group}'") + struct.pack("<I", 0xFFFFFFFF) + props({})
     raw = b""
     for name, (data, p) in channels.items():
-        meta += text(f"/'{group}'/'{name}'") + struct.pack("<IIIQ", 20, 10, 1, len(data)) + props(p)
-        raw += np.asarray(data, "<f8").tobytes()
+        stamps = data.dtype.names == ("fractions", "seconds")  # time stamps (type 0x44): u64 2^-64 s, i64 s
+        meta += text(f"/'{group}'/'{name}'") + struct.pack("<IIIQ", 20, 0x44 if stamps else 10, 1, len(data))
+        meta += props(p)
+        raw += data.astype([("fractions", "<u8"), ("seconds", "<i8")] if stamps else "<f8").tobytes()
     lead = b"TDSm" + struct.pack("<iiQQ", 2 | 4 | 8, 4713, len(meta) + len(raw), len(meta))
     path.write_bytes(lead + meta + raw)
 
 
 def test_a_tdms_file_written_from_ni_s_description_of_the_format_is_read(tmp_path):
     """A file whose bytes follow NI's format description (not npTDMS's writer): its waveform timing gives the
-    record's time (offset 0.25 s, 1 kHz), its unit_string is checked, its samples read to SI."""
+    record's time (offset 0.25 s, 1 kHz), or a channel of time stamps does; its unit_string is checked, its
+    samples read to SI."""
     x, force = np.sin(np.arange(2000) / 50.0), np.cos(np.arange(2000) / 50.0)
     wave = {"wf_increment": 1e-3, "wf_start_offset": 0.25}
     path = tmp_path / "shaker.tdms"
@@ -591,7 +603,20 @@ def test_a_tdms_file_written_from_ni_s_description_of_the_format_is_read(tmp_pat
     assert m.sample_rate_hz == pytest.approx(1000.0, rel=1e-12)
     assert np.max(np.abs(m.t - (0.25 + np.arange(2000) / 1000.0))) < 1e-12
     assert np.array_equal(m.values["Laser"], x * 1e-3) and np.array_equal(m.values["Force"], force * 1e3)
-    path.with_suffix(".toml").write_text(path.with_suffix(".toml").read_text().replace('"mm"', '"m"'))
+    # a logger's time stamps instead (whole seconds since 1904 and 2^-64 s fractions, 750 Hz from 0.3 s past a
+    # second): the time channel reads to better than a nanosecond (stamps cut to the microsecond, as datetime64[us]
+    # holds them, would put the grid about 0.4 us off)
+    k = np.arange(2000)
+    whole, frac = np.divmod(0.3 + k / 750.0, 1.0)
+    stamps = np.zeros(2000, [("fractions", "u8"), ("seconds", "i8")])
+    stamps["seconds"], stamps["fractions"] = 3_860_000_000 + whole.astype(int), np.round(frac * 2.0**64)
+    _tdms_by_the_spec(path, "Untitled", {"Time": (stamps, {}), "Laser": (x, {"unit_string": "mm"}),
+                                         "Force": (force, {"unit_string": "kN"})})
+    side = path.with_suffix(".toml")
+    side.write_text('time_column = "Time"\n' + side.read_text())
+    m = read_measurement(path)
+    assert m.sample_rate_hz == pytest.approx(750.0, rel=1e-12) and np.max(np.abs(m.t - k / 750.0)) < 1e-9
+    side.write_text(side.read_text().replace('"mm"', '"m"'))
     with pytest.raises(MeasurementError, match=r"channel 'Laser' has the unit 'mm' but shaker.toml says 'm'"):
         read_measurement(path)
     path.with_suffix(".toml").write_text('time_unit = "clock"\n' + path.with_suffix(".toml").read_text())
