@@ -45,6 +45,7 @@ def found_where_it_acts(root, fmu_dir, effect, measured):
     lo, hi = rep["gap"]["worst_band_hz"]
     assert lo <= F0 <= hi
     assert rep["gap"]["overall"] > 5 * rep["gap"]["noise_floor"]
+    assert rep["clipped_channels"] == {}  # the noisy records within range: no channel taken for a clipped one
     assert (root / f"out_{effect}" / "report.md").is_file()
 
 

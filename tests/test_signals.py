@@ -187,3 +187,23 @@ def test_band_limited_noise_has_its_rms_its_band_and_a_gaussian_spread(measured)
     measured("band-limited noise: |kurtosis - 3| (Gaussian: 0)", abs(scipy.stats.kurtosis(x, fisher=False) - 3), 0.2)
     assert np.max(np.abs(_on_casadi(n, t[:2000:7]) - n(t[:2000:7]))) < 1e-9 * rms
     assert not np.allclose(band_noise(5.0, 80.0, rms, seed=8)(t[:1000]), n(t[:1000]))
+
+
+def test_a_channel_held_at_its_range_limit_is_told_from_one_within_its_range():
+    """A 13 Hz sine with 1 % noise, sampled at 10 kHz, cut at 0.8 of its amplitude at one or both ends (a range
+    limit: the samples beyond it read as the limit): the samples held there are the share of time the sine spends
+    beyond 0.8, (pi - 2 asin 0.8) / (2 pi) = 0.2048 per end, to the noise's blur. Within its range, a signal
+    gives none, even a slow sine quantized to 16 or 12 bits (its peaks stay on one code for several samples,
+    about 2.4 x as many as the code below: the arcsine density at the edge) or a quantized multisine."""
+    rng = np.random.default_rng(0)
+    n = 200_000
+    t = np.arange(n) / 10_000.0
+    s = np.sin(2 * np.pi * 13 * t) + rng.normal(0.0, 0.01, n)
+    share = (np.pi - 2 * np.arcsin(0.8)) / (2 * np.pi)
+    assert signals.clipped_samples(np.clip(s, -2.0, 0.8)) == pytest.approx(share * n, rel=0.01)
+    assert signals.clipped_samples(np.clip(s, -0.8, 0.8)) == pytest.approx(2 * share * n, rel=0.01)
+    assert signals.clipped_samples(s) == 0
+    assert signals.clipped_samples(np.round(0.5 * 32767 * np.sin(2 * np.pi * 5 * t)) / 32767) == 0
+    assert signals.clipped_samples(np.round(0.9 * 2047 * np.sin(2 * np.pi * 0.5 * t)) / 2047) == 0
+    m = np.tile(multisine(8192, 1000.0, 5.0, 80.0, 1.0, 3), 3) + rng.normal(0.0, 0.01, 3 * 8192)
+    assert signals.clipped_samples(m) == 0 and signals.clipped_samples(np.round(m / 1e-3) * 1e-3) == 0

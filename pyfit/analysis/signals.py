@@ -234,3 +234,26 @@ def delayed(y: np.ndarray, fs: float, delay_s: float, periodic: bool = False) ->
         return np.fft.irfft(np.fft.rfft(y) * np.exp(-2j * np.pi * f * delay_s), len(y))
     t = np.arange(len(y)) / fs
     return scipy.interpolate.CubicSpline(t, y)(np.clip(t - delay_s, 0.0, t[-1]))
+
+
+CLIP_RUN = 3  # consecutive samples at the extreme value that a range limit holds and a signal's peak seldom does
+CLIP_EDGE = 8.0  # the extreme value's count over its nearest distinct value's: a range limit piles the samples
+# beyond it there; a sine's peak code holds about 2.4 x its neighbour's (the arcsine density at the edge)
+
+
+def clipped_samples(y: np.ndarray) -> int:
+    """Samples [count] held at the channel's largest or smallest value by a range limit (an overloaded sensor,
+    amplifier or ADC): that value taken in runs of at least CLIP_RUN consecutive samples, and at least CLIP_EDGE
+    times as often as the nearest value inside it. A signal within its range gives 0, also one quantized so
+    coarsely that its peaks stay on one code for several samples."""
+    y = np.asarray(y)
+    values, counts = np.unique(y, return_counts=True)
+    if len(values) < 3:
+        return 0
+    held = 0
+    for edge, inner in ((0, 1), (-1, -2)):
+        steps = np.diff(np.concatenate(([0], (y == values[edge]).astype(np.int8), [0])))
+        longest = np.max(np.flatnonzero(steps == -1) - np.flatnonzero(steps == 1))  # the longest run at that value
+        if longest >= CLIP_RUN and counts[edge] >= CLIP_EDGE * counts[inner]:
+            held += int(counts[edge])
+    return held

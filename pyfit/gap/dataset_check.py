@@ -10,8 +10,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pyfit.analysis.signals import clipped_samples
 from pyfit.gap import localise
 from pyfit.gap.diagnose import DiagnoseConfig, prepare
+from pyfit.gap.report import CLIPPED_NOTE
 from pyfit.io.data import TO_SI
 
 
@@ -26,6 +28,7 @@ class ChannelCheck:
     model_unit: str  # the FMU's unit of that variable
     rms_si: float  # RMS of the column about its mean, in the model's unit
     inverted: bool
+    clipped: int  # samples held at the column's extreme by a range limit (signals.clipped_samples)
 
 
 @dataclass(frozen=True)
@@ -82,7 +85,8 @@ def check_dataset(model: str, data_dir, nominal=None, cfg: DiagnoseConfig | None
                         f"{ch.unit} ({ch.volts_per_unit / TO_SI[ch.unit]:g} {ch.unit}/{ch.measures})"
                     v = m.values[col]
                     channels.append(ChannelCheck(col, side, unit, ch.model_variable, units.get(ch.model_variable, ""),
-                                                 float(np.sqrt(np.mean((v - np.mean(v)) ** 2))), ch.invert))
+                                                 float(np.sqrt(np.mean((v - np.mean(v)) ** 2))), ch.invert,
+                                                 clipped_samples(v)))
             rec = records.get(name)
             length = float(m.t[-1] - m.t[0] + 1 / m.sample_rate_hz)
             files.append(FileCheck(name, m.level, float(m.level_value), length, roles.get(name, "set aside"),
@@ -116,6 +120,9 @@ def check_text(c: DatasetCheck) -> str:
             sign = "inverted" if ch.inverted else "as recorded"
             lines.append(f"| {f.name} | {ch.column} | {ch.side} | {ch.unit} | {ch.model_variable} "
                          f"[{ch.model_unit or '—'}] | {ch.rms_si:.4g} | {sign} |")
+    clipped = [f"{f.name} {ch.column} ({ch.clipped} samples)" for f in c.files for ch in f.channels if ch.clipped]
+    if clipped:
+        lines += ["", f"{CLIPPED_NOTE}: " + ", ".join(clipped) + "."]
     if c.recorded_hz:
         lines += ["", f"Recorded faster and decimated to the dataset's {c.file_hz:g} Hz: "
                   + ", ".join(f"{name} ({hz:g} Hz)" for name, hz in c.recorded_hz.items()) + "."]

@@ -16,6 +16,7 @@ import threadpoolctl
 
 from pyfit.runtime.batch import map_tasks
 from pyfit.runtime.clock import StageClock
+from pyfit.analysis.signals import clipped_samples
 from pyfit.io.data import MeasurementError, check_quantities, read_dataset_with_order
 from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
@@ -107,6 +108,7 @@ class Dataset:
     recorded_hz: dict  # name -> the rate a file was recorded at, where it was faster than the dataset's
     # (rate.common_rate: decimated to the slowest file's rate)
     measurements: list  # the files as read, in level order (pyfit.io.data.Measurement: columns, units, SI values)
+    clipped: dict  # 'file column' -> samples held at the column's extreme by a range limit (signals.clipped_samples)
 
 
 def default_calibration(records: list) -> list:
@@ -192,8 +194,9 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
     for m in ms:
         digest.update(m.path.read_bytes())
         digest.update(m.path.with_suffix(".toml").read_bytes())
+    clipped = {f"{m.name} {col}": n for m in read for col, v in m.values.items() if (n := clipped_samples(v))}
     return Dataset(records, cal, held, digest.hexdigest()[:16], order, aside, sorted(voltages), rate, recorded_hz,
-                   read)
+                   read, clipped)
 
 
 def _simulated(runner, records, values: dict, system, cfg: DiagnoseConfig) -> dict:
@@ -932,6 +935,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     result["level_order"] = data.order
     result["set_aside"] = {name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in data.aside.items()}
     result["voltage_channels"] = data.voltages
+    result["clipped_channels"] = data.clipped
     result["analysis_rate"] = {**asdict(data.rate), "drive_upsample": cfg.upsample, "recorded_hz": data.recorded_hz}
     top = result["ranking"][0]["shrink_pct"] if result["ranking"] else None
     calibration = confidence.load(confidence.settings_of(asdict(requested)), model)  # of the settings asked for
