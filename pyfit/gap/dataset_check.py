@@ -10,7 +10,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyfit.analysis.signals import clipped_samples
 from pyfit.gap import localise
 from pyfit.gap.diagnose import DiagnoseConfig, prepare
 from pyfit.gap.report import CLIPPED_NOTE
@@ -28,7 +27,7 @@ class ChannelCheck:
     model_unit: str  # the FMU's unit of that variable
     rms_si: float  # RMS of the column about its mean, in the model's unit
     inverted: bool
-    clipped: int  # samples held at the column's extreme by a range limit (signals.clipped_samples)
+    clipped: int  # samples held at the column's extreme by a range limit (the diagnosis's Dataset.clipped)
 
 
 @dataclass(frozen=True)
@@ -86,7 +85,7 @@ def check_dataset(model: str, data_dir, nominal=None, cfg: DiagnoseConfig | None
                     v = m.values[col]
                     channels.append(ChannelCheck(col, side, unit, ch.model_variable, units.get(ch.model_variable, ""),
                                                  float(np.sqrt(np.mean((v - np.mean(v)) ** 2))), ch.invert,
-                                                 clipped_samples(v)))
+                                                 p.data.clipped.get(f"{name} {col}", 0)))
             rec = records.get(name)
             length = float(m.t[-1] - m.t[0] + 1 / m.sample_rate_hz)
             files.append(FileCheck(name, m.level, float(m.level_value), length, roles.get(name, "set aside"),
