@@ -661,19 +661,28 @@ def test_an_ni_tdms_file_that_cannot_be_used_is_refused_naming_the_fix(tmp_path)
 
 
 def _uff58(id1: str, node: int, direction: int, unit: str, data: np.ndarray, dt: float, t0: float = 0.0,
-           spec: int = 8, function: int = 1, abscissa: int = 17) -> str:
+           spec: int = 8, function: int = 1, abscissa: int = 17, binary: str | None = None) -> str | bytes:
     """One time record (universal dataset 58, ASCII, real double) written line by line from the format's
     description, not by the library the reader uses: the delimiters, five ID lines, the DOF identification
     (`function` type, 1: time response; the response node and direction), the data form (type 4, even spacing,
     abscissa start and increment), the abscissa (specific data type `abscissa`, 17: time) and ordinate (`spec`,
-    its unit label) characteristics, then the values four to a line (E20.12)."""
-    lines = ["    -1", "    58", id1, "NONE", "NONE", "NONE", "NONE",
+    its unit label) characteristics, then the values four to a line (E20.12). With `binary` (a numpy dtype:
+    '<f8', '>f4', ...) the record is dataset 58b: an ID line naming the byte order (1: little, 2: big endian),
+    the IEEE format, the 11 ASCII lines and the data's bytes, the same 11 lines (data type 4 or 2: double or
+    single), then the values' bytes with the closing delimiter right after them (returned as bytes)."""
+    raw = None if binary is None else np.asarray(data, dtype=binary).tobytes()
+    dtype = np.dtype(binary or "<f8")
+    head = "    58" if raw is None else \
+        f"{58:6d}b{1 if dtype.byteorder in '<=' else 2:6d}{2:6d}{11:12d}{len(raw):12d}{0:6d}{0:6d}{0:12d}{0:12d}"
+    lines = ["    -1", head, id1, "NONE", "NONE", "NONE", "NONE",
              f"{function:5d}{0:10d}{0:5d}{0:10d} {'NONE':10s}{node:10d}{direction:4d} {'NONE':10s}{0:10d}{0:4d}",
-             f"{4:10d}{len(data):10d}{1:10d}{t0:13.5e}{dt:13.5e}{0.0:13.5e}",
+             f"{4 if dtype.itemsize == 8 else 2:10d}{len(data):10d}{1:10d}{t0:13.5e}{dt:13.5e}{0.0:13.5e}",
              f"{abscissa:10d}{0:5d}{0:5d}{0:5d} {'NONE':20s} {'NONE':20s}",
              f"{spec:10d}{0:5d}{0:5d}{0:5d} {'NONE':20s} {unit:20s}",
              f"{0:10d}{0:5d}{0:5d}{0:5d} {'NONE':20s} {'NONE':20s}",
              f"{0:10d}{0:5d}{0:5d}{0:5d} {'NONE':20s} {'NONE':20s}"]
+    if raw is not None:
+        return ("\n".join(lines) + "\n").encode("ascii") + raw + b"    -1\n"
     lines += ["".join(f"{v:20.12e}" for v in data[i:i + 4]) for i in range(0, len(data), 4)]
     return "\n".join(lines + ["    -1"]) + "\n"
 
@@ -708,6 +717,28 @@ def test_a_universal_file_s_time_records_read_to_the_numbers_of_their_csv_twin(t
         read_measurement(path)
     side_file.write_text(side.replace("x_mm =", '"#4" ='))
     assert np.allclose(read_measurement(path).values["#4"], twin.values["x_mm"], rtol=1e-11, atol=0)
+
+
+@pytest.mark.parametrize("dtype", ["<f8", ">f4"])
+def test_a_binary_universal_file_s_time_records_read_to_the_numbers_of_their_csv_twin(tmp_path, dtype):
+    """Dataset 58b, the binary form test software such as Simcenter Testlab can export, written from the
+    format's description (doubles in little-endian order as a PC writes them; singles in big-endian order as a
+    workstation did): read to the CSV twin's numbers, exactly for doubles, to single precision (2^-24 of each
+    value) for singles; timed by the abscissa increment as the ASCII form."""
+    csv = lab_file(tmp_path, "run")
+    twin = read_measurement(csv)
+    t, x, force = np.loadtxt(csv, delimiter=",", skiprows=3, usecols=(0, 1, 2)).T
+    side = csv.with_suffix(".toml").read_text().replace(f"sample_rate_hz = {FS}\n", "")
+    csv.unlink()
+    path = tmp_path / "run.uff"
+    path.write_bytes(_uff58("F_kN", 1, 3, "kN", force, 1 / FS, spec=13, binary=dtype)
+                     + _uff58("Laser", 101, 3, "mm", x, 1 / FS, binary=dtype))
+    path.with_suffix(".toml").write_text(side.replace("x_mm =", '"101:+Z" ='))
+    m = read_measurement(path)
+    assert m.sample_rate_hz == pytest.approx(FS, rel=1e-12) and np.max(np.abs(m.t - twin.t)) < 1e-9
+    rtol = 0.0 if dtype.endswith("8") else 2.0**-24
+    assert np.allclose(m.values["101:+Z"], twin.values["x_mm"], rtol=rtol, atol=0)
+    assert np.allclose(m.values["F_kN"], twin.values["F_kN"], rtol=rtol, atol=0)
 
 
 @pytest.mark.parametrize("rate", [750.0, 1000.0, 1651.2, 2048.0, 2560.0, 8192.0, 12800.0, 25600.0, 48000.0, 51200.0])

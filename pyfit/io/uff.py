@@ -1,10 +1,11 @@
 """The time records of a universal file (UFF/UNV, dataset 58: what modal and vibration test software such as
 Simcenter Testlab, m+p, PULSE and Dewesoft export), read with pyuff. A record of real values whose abscissa is
-time (function type 1, time response, or an abscissa of specific data type 17, time) at even spacing is a
-channel, named by its position in the file ('#3'), by its first ID line (id1, what the test software calls the
-channel) and by its response node and direction ('101:+Z'), each where no other record holds that name; its
-unit is the ordinate's unit label, its timing the abscissa's minimum and increment (increment_of: the header
-holds six significant digits). Spectra, FRFs, complex and unevenly spaced records are left aside.
+time (function type 1, time response, or an abscissa of specific data type 17, time) at even spacing, in ASCII
+or binary (58b, either byte order, single or double precision), is a channel, named by its position in the file
+('#3'), by its first ID line (id1, what the test software calls the channel) and by its response node and
+direction ('101:+Z'), each where no other record holds that name; its unit is the ordinate's unit label, its
+timing the abscissa's minimum and increment (increment_of: the header holds six significant digits). Spectra,
+FRFs, complex and unevenly spaced records are left aside.
 """
 from __future__ import annotations
 
