@@ -844,3 +844,119 @@ def test_a_time_column_of_clock_stamps_reads_as_seconds_from_the_first(tmp_path,
     side.write_text(side.read_text().replace('time_unit = "clock"\n', ""))
     with pytest.raises(MeasurementError, match=r'a time column of clock times: time_unit = "clock"'):
         read_measurement(path)
+
+
+def _xlsx_by_the_spec(path, rows: list[list]) -> None:
+    """A one-sheet workbook written from the Office Open XML description (ECMA-376: the package's content types
+    and relationships, a workbook naming the sheet, the sheet's rows of cells), not by the library the reader
+    uses: text as inline strings, numbers as their shortest repr (read back bit for bit)."""
+    import zipfile
+    from xml.sax.saxutils import escape
+
+    def cell(ref, v):
+        if isinstance(v, str):
+            return f'<c r="{ref}" t="inlineStr"><is><t>{escape(v)}</t></is></c>'
+        return f'<c r="{ref}"><v>{v!r}</v></c>'
+
+    def ref(col, row):
+        return f"{chr(ord('A') + col)}{row}"
+
+    sheet = "".join(f'<row r="{i}">' + "".join(cell(ref(j, i), v) for j, v in enumerate(r) if v is not None)
+                    + "</row>" for i, r in enumerate(rows, 1) if r)
+    ns = "http://schemas.openxmlformats.org"
+    parts = {
+        "[Content_Types].xml": f'<Types xmlns="{ns}/package/2006/content-types">'
+        '<Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/>'
+        '<Default Extension="xml" ContentType="application/xml"/>'
+        '<Override PartName="/xl/workbook.xml" ContentType="application/vnd.openxmlformats-officedocument.'
+        'spreadsheetml.sheet.main+xml"/><Override PartName="/xl/worksheets/sheet1.xml" ContentType="application/'
+        'vnd.openxmlformats-officedocument.spreadsheetml.worksheet+xml"/></Types>',
+        "_rels/.rels": f'<Relationships xmlns="{ns}/package/2006/relationships"><Relationship Id="rId1" '
+        f'Type="{ns}/officeDocument/2006/relationships/officeDocument" Target="xl/workbook.xml"/></Relationships>',
+        "xl/workbook.xml": f'<workbook xmlns="{ns}/spreadsheetml/2006/main" xmlns:r="{ns}/officeDocument/2006/'
+        'relationships"><sheets><sheet name="Messung" sheetId="1" r:id="rId1"/></sheets></workbook>',
+        "xl/_rels/workbook.xml.rels": f'<Relationships xmlns="{ns}/package/2006/relationships"><Relationship '
+        f'Id="rId1" Type="{ns}/officeDocument/2006/relationships/worksheet" Target="worksheets/sheet1.xml"/>'
+        '</Relationships>',
+        "xl/worksheets/sheet1.xml": f'<worksheet xmlns="{ns}/spreadsheetml/2006/main"><sheetData>{sheet}'
+        '</sheetData></worksheet>'}
+    with zipfile.ZipFile(path, "w") as z:
+        for name, xml in parts.items():
+            z.writestr(name, '<?xml version="1.0" encoding="UTF-8" standalone="yes"?>' + xml)
+
+
+def _twin_rows(csv) -> tuple[list[str], list[list]]:
+    """The CSV twin's header names and its rows as numbers (the text column as text)."""
+    names = ["t", "x_mm", "F_kN", "status", "T_room"]
+    body = [line.split(",") for line in csv.read_text().splitlines()[3:] if line]
+    return names, [[float(a), float(b), float(c), s, float(d)] for a, b, c, s, d in body]
+
+
+def test_an_excel_sheet_written_from_the_format_s_description_reads_to_the_numbers_of_its_csv_twin(tmp_path):
+    """A workbook written from the Office Open XML description (not by openpyxl, which reads it), its one sheet
+    holding a title row, an empty row, the twin's header and its rows: read to the twin's numbers exactly (a
+    cell holds the double the CSV's text parses to) with its time; `sheet` naming a sheet the workbook lacks
+    refused listing the ones it holds."""
+    csv = lab_file(tmp_path, "run", t=np.arange(3000) / FS)
+    twin = read_measurement(csv)
+    names, rows = _twin_rows(csv)
+    side = csv.with_suffix(".toml").read_text()
+    csv.unlink()
+    path = tmp_path / "run.xlsx"
+    _xlsx_by_the_spec(path, [["Schwingtisch 2, Versuch 3"], [], names, *rows])
+    m = read_measurement(path)
+    assert m.sample_rate_hz == pytest.approx(FS, rel=1e-12) and np.max(np.abs(m.t - twin.t)) < 1e-9
+    assert np.array_equal(m.values["x_mm"], twin.values["x_mm"])
+    assert np.array_equal(m.values["F_kN"], twin.values["F_kN"])
+    path.with_suffix(".toml").write_text('sheet = "Run 3"\n' + side)
+    with pytest.raises(MeasurementError, match=r"run.xlsx: not readable as an Excel workbook \(no sheet 'Run 3'; "
+                                               r"sheets: Messung\)"):
+        read_measurement(path)
+
+
+def test_an_excel_workbook_s_named_sheet_with_units_and_clock_times_is_read(tmp_path):
+    """A workbook as a bench's spreadsheet holds one (written by openpyxl): a settings sheet first, the run on a
+    sheet the sidecar names, title rows, a units row under the header, the time as the spreadsheet's date-time
+    cells (time_unit = "clock"; 500 Hz, whole milliseconds apart: such a cell is read to the millisecond) and the
+    rate taken from them: the numbers of the CSV twin, the same time; a units row that contradicts the sidecar,
+    a file that is no workbook and `sheet` beside a CSV are refused."""
+    import datetime
+    import openpyxl
+
+    csv = lab_file(tmp_path, "run", t=np.arange(3000) / 500.0)
+    side = csv.with_suffix(".toml").read_text().replace(f"sample_rate_hz = {FS}\n", "")
+    csv.with_suffix(".toml").write_text(side)
+    twin = read_measurement(csv)
+    names, rows = _twin_rows(csv)
+    csv.unlink()
+    start = datetime.datetime(2026, 5, 4, 10, 15, 32)
+    book = openpyxl.Workbook()
+    book.active.title = "Settings"
+    book.active.append(["shaker", "2"])
+    run = book.create_sheet("Run 3")
+    run.append(["Sine 13 Hz"])
+    run.append(names)
+    run.append(["hh:mm:ss", "mm", "kN", "", "degC"])
+    for r in rows:
+        run.append([start + datetime.timedelta(seconds=r[0])] + r[1:])
+    path = tmp_path / "run.xlsx"
+    book.save(path)
+    path.with_suffix(".toml").write_text(f'sheet = "Run 3"\ntime_unit = "clock"\n' + side)
+    m = read_measurement(path)
+    assert m.sample_rate_hz == pytest.approx(500.0, rel=1e-12)
+    assert np.max(np.abs((m.t - m.t[0]) - (twin.t - twin.t[0]))) < 1e-9
+    assert np.array_equal(m.values["x_mm"], twin.values["x_mm"])
+    assert np.array_equal(m.values["F_kN"], twin.values["F_kN"])
+    run.cell(row=3, column=2).value = "m"
+    book.save(path)
+    with pytest.raises(MeasurementError, match=r"run.xlsx: row 3: the units row gives 'm' for column 'x_mm' but "
+                                               r"run.toml says 'mm'"):
+        read_measurement(path)
+    path.write_text("t,x_mm\n0,1\n")
+    with pytest.raises(MeasurementError, match=r"run.xlsx: not readable as an Excel workbook \("):
+        read_measurement(path)
+    path.unlink()
+    lab_file(tmp_path, "run")
+    path.with_suffix(".toml").write_text('sheet = "Run 3"\n' + side)
+    with pytest.raises(MeasurementError, match=r"run.toml: \[sheet\] .*; allowed: a sheet of an Excel workbook"):
+        read_measurement(tmp_path / "run.csv")

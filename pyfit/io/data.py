@@ -2,7 +2,8 @@
 or a MATLAB .mat file (any format, v4 to v7.3: pyfit.io.matlab) whose vectors, a struct's fields ('s.x') or one
 matrix's columns (named by the sidecar's `columns`) are the columns, or an NI TDMS file (pyfit.io.tdms) whose channels
 ('group/channel', or the channel's name where unique) are, timed by their waveform properties, or a universal file
-(.uff, .unv; pyfit.io.uff) whose time records (dataset 58) are.
+(.uff, .unv; pyfit.io.uff) whose time records (dataset 58) are, or a sheet of an Excel workbook (.xlsx, .xlsm;
+pyfit.io.excel) read as the text of its CSV export.
 
 Sidecar keys: model, sample_rate_hz (optional where the file has a time column: its rate, rate_of), [inputs]
 and [outputs] mapping column -> {unit, model_variable[, weight, sensitivity, invert]} (sensitivity: a voltage
@@ -10,7 +11,8 @@ column's sensor, e.g. "100 mV/g": read as what the sensor measures; invert = tru
 is the model's opposite, read with its sign changed);
 optional level, level_value, excitation, notes, time_column (default "t"), time_unit ("s", "ms" or "clock":
 wall-clock stamps, the record's time counted from its first), columns (the
-names of the columns of a file without a header line, in order), [[segments]] (a file holding several levels or
+names of the columns of a file without a header line, in order), sheet (an Excel workbook's sheet; default:
+its first), [[segments]] (a file holding several levels or
 runs: from_s, to_s and optionally level, level_value, excitation each; read as one measurement per segment).
 
 The reader takes files as lab software writes them, wherever that is still unambiguous:
@@ -53,6 +55,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from pyfit.io.excel import ExcelFileError, sheet_text
 from pyfit.io.matlab import MatlabFileError, mat_variables
 from pyfit.io.schema import ConfigError, check_table, fail, read_text, read_toml
 from pyfit.io.tdms import TdmsFileError, tdms_channels
@@ -75,7 +78,8 @@ MAX_TIME_SLIP = 0.25  # largest allowed distance [samples] of a time stamp from 
 SIDECAR = {"model": (str, True, None), "sample_rate_hz": ("number", False, None), "inputs": (dict, False, {}),
            "outputs": (dict, True, None), "level": (str, False, ""), "level_value": ("number", False, None),
            "excitation": (dict, False, {}), "notes": (str, False, ""), "time_column": (str, False, "t"),
-           "time_unit": (str, False, "s"), "columns": ("strings", False, None), "segments": (list, False, [])}
+           "time_unit": (str, False, "s"), "columns": ("strings", False, None), "segments": (list, False, []),
+           "sheet": (str, False, None)}
 SEGMENT = {"from_s": ("number", True, None), "to_s": ("number", True, None), "level": (str, False, ""),
            "level_value": ("number", False, None), "excitation": (dict, False, {})}  # one [[segments]] table
 
@@ -454,10 +458,14 @@ def check_time(t: np.ndarray, fs: float, csv_path, side, column: str, first_row:
                                f"{slip[k]:+.2f} samples off the grid; allowed: within {MAX_TIME_SLIP} samples)")
 
 
-def _text_columns(csv_path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
+def _text_columns(csv_path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel],
+                  text: str | None = None):
     """The used columns of a text file (the time column's first, if the file has it), the time column's name (or
-    None) and the rows above the first sample (error messages count rows from there)."""
-    text = read_text(csv_path, MeasurementError)
+    None) and the rows above the first sample (error messages count rows from there); `text`: the file's content
+    when it is not the file's own text (a worksheet's: _excel_columns)."""
+    if meta["sheet"] is not None and text is None:
+        fail(side, "sheet", f"'{meta['sheet']}' for {csv_path.name}", EXCEL_SHEET, MeasurementError)
+    text = read_text(csv_path, MeasurementError) if text is None else text
     head = _header(csv_path, text, list(channels), meta["columns"])
     names, skip = head.names, head.skip
     for name, ch in channels.items():
@@ -477,6 +485,22 @@ def _text_columns(csv_path: pathlib.Path, side: pathlib.Path, meta: dict, channe
     clock = time_col if meta["time_unit"] == CLOCK else None
     return (_load_columns(csv_path, text, head, ([time_col] if time_col else []) + list(channels), clock), time_col,
             skip)
+
+
+EXCEL_ALLOWED = ("an Excel workbook (.xlsx or .xlsm) whose sheet (the sidecar's `sheet`, else the first) holds the "
+                 "used columns under a header row naming them")
+EXCEL_SHEET = "a sheet of an Excel workbook (.xlsx or .xlsm) only"
+
+
+def _excel_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
+    """The used columns of a worksheet (pyfit.io.excel: read as the text of the sheet's CSV export, rows
+    numbered as the spreadsheet numbers them), as _text_columns gives a text file's."""
+    try:
+        text = sheet_text(path, meta["sheet"])
+    except ExcelFileError as exc:
+        raise MeasurementError(f"{path}: not readable as an Excel workbook ({exc}); allowed: {EXCEL_ALLOWED}") \
+            from exc
+    return _text_columns(path, side, meta, channels, text)
 
 
 MAT_ALLOWED = ("a MATLAB file (v4, v6, v7 or v7.3) holding the columns as vectors of one length, as fields of a "
@@ -604,8 +628,8 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
         fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join((*TIME_UNITS, CLOCK)), MeasurementError)
     inputs = _channels(side, meta["inputs"], "inputs")
     outputs = _channels(side, meta["outputs"], "outputs")
-    read = {".mat": _mat_columns, ".tdms": _tdms_columns, ".uff": _uff_columns, ".unv": _uff_columns}.get(
-        csv_path.suffix.lower(), _text_columns)
+    read = {".mat": _mat_columns, ".tdms": _tdms_columns, ".uff": _uff_columns, ".unv": _uff_columns,
+            ".xlsx": _excel_columns, ".xlsm": _excel_columns}.get(csv_path.suffix.lower(), _text_columns)
     cols, time_col, skip = read(csv_path, side, meta, {**inputs, **outputs})
     n = len(next(iter(cols.values())))
     if fs is None and not time_col:
@@ -771,7 +795,7 @@ def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool
 
 
 # a measurement file's extensions, in any case
-DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc", ".mat", ".tdms", ".uff", ".unv")
+DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc", ".mat", ".tdms", ".uff", ".unv", ".xlsx", ".xlsm")
 
 
 def measurement_files(folder: str | pathlib.Path) -> list[pathlib.Path]:
