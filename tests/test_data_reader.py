@@ -896,18 +896,23 @@ def test_an_excel_sheet_written_from_the_format_s_description_reads_to_the_numbe
     """A workbook written from the Office Open XML description (not by openpyxl, which reads it), its one sheet
     holding a title row, an empty row, the twin's header and its rows: read to the twin's numbers exactly (a
     cell holds the double the CSV's text parses to) with its time; `sheet` naming a sheet the workbook lacks
-    refused listing the ones it holds."""
+    refused listing the ones it holds; a row named in an error is the spreadsheet's (a title cell of two lines
+    counted as one row)."""
     csv = lab_file(tmp_path, "run", t=np.arange(3000) / FS)
     twin = read_measurement(csv)
     names, rows = _twin_rows(csv)
     side = csv.with_suffix(".toml").read_text()
     csv.unlink()
     path = tmp_path / "run.xlsx"
-    _xlsx_by_the_spec(path, [["Schwingtisch 2, Versuch 3"], [], names, *rows])
+    _xlsx_by_the_spec(path, [["Schwingtisch 2, Versuch 3\nBetreiber: X"], [], names, *rows])
     m = read_measurement(path)
     assert m.sample_rate_hz == pytest.approx(FS, rel=1e-12) and np.max(np.abs(m.t - twin.t)) < 1e-9
     assert np.array_equal(m.values["x_mm"], twin.values["x_mm"])
     assert np.array_equal(m.values["F_kN"], twin.values["F_kN"])
+    rows[99][1] = "NaN"  # in the spreadsheet's row 103: under a title of two lines, an empty row and the header
+    _xlsx_by_the_spec(path, [["Schwingtisch 2, Versuch 3\nBetreiber: X"], [], names, *rows])
+    with pytest.raises(MeasurementError, match=r"run.xlsx: row 103: column 'x_mm' is not finite"):
+        read_measurement(path)
     path.with_suffix(".toml").write_text('sheet = "Run 3"\n' + side)
     with pytest.raises(MeasurementError, match=r"run.xlsx: not readable as an Excel workbook \(no sheet 'Run 3'; "
                                                r"sheets: Messung\)"):

@@ -16,20 +16,21 @@ class ExcelFileError(ValueError):
 
 
 def _cell_text(value) -> str:
-    """One cell as a CSV export writes it: numbers at full precision, dates and times as ISO text, text quoted
-    where it holds a comma or a quote, nothing for an empty cell."""
+    """One cell as a CSV export writes it: numbers at full precision (a logical as 0 or 1), dates and times as
+    ISO text, text on one line (a line break in a cell as a space: line k stays row k) and quoted where it holds
+    a comma or a quote, nothing for an empty cell."""
     if value is None:
         return ""
-    if isinstance(value, bool):
+    if isinstance(value, (bool, int)):
         return str(int(value))
-    if isinstance(value, (int, float)):
-        return repr(float(value)) if isinstance(value, float) else str(value)
+    if isinstance(value, float):
+        return repr(value)
     if isinstance(value, datetime.datetime):
         return value.isoformat(sep=" ")
     if isinstance(value, (datetime.time, datetime.date)):
         return value.isoformat()
-    text = str(value)
-    return f'"{text.replace(chr(34), chr(34) * 2)}"' if any(c in text for c in ',"\n\r') else text
+    text = " ".join(str(value).splitlines())
+    return f'"{text.replace(chr(34), chr(34) * 2)}"' if any(c in text for c in ',"') else text
 
 
 def sheet_text(path: str | pathlib.Path, sheet: str | None = None) -> str:
