@@ -171,6 +171,26 @@ class CaseJob:
     cfg: DiagnoseConfig = field(default_factory=DiagnoseConfig)  # the diagnosis's settings
 
 
+def write_case(c: Case, out: pathlib.Path, record_s: float = RECORD_S) -> tuple[Case, pathlib.Path,
+                                                                               NominalModel | None]:
+    """Write one case's files into `out` as a lab would (records of `record_s` seconds where not periodic);
+    returns the case with each withheld effect scaled to its drawn size, the dataset folder and what the user
+    describes: for a damper its geometry (the messenger's EI and damping, the family's linear parameters, are
+    what the nominal calibrates), else None."""
+    family = datasets.FAMILIES[c.model]
+    if c.band_hz:
+        family = dataclasses.replace(family, band_hz=tuple(c.band_hz))
+    style = datasets.LabStyle(c.excitation, tuple(c.outputs), c.motion, record_s=record_s)
+    record = dict(seed=c.seed, periods=PERIODS, style=style, base=c.base)
+    if c.sizes:  # each withheld effect scaled to its drawn size on the records as they will be written
+        c = dataclasses.replace(c, truth=sizing.sized(c.truth, c.model, c.sizes, lambda truth: datasets.effect_sizes(
+            family, c.withheld, truth=truth, **record)))
+    data = datasets.write_dataset(out, family, c.withheld, truth=c.truth or None, **record)
+    linear = FAMILY[c.model].linear
+    described = NominalModel(c.model, {k: v for k, v in c.base.items() if k not in linear}) if c.base else None
+    return c, data, described
+
+
 def run_case(job: CaseJob) -> dict:
     """Write one case's files, diagnose them (one core), return the outcome; a finished case (its outcome.json)
     is read, not redone: an interrupted campaign resumes."""
@@ -184,21 +204,8 @@ def run_case(job: CaseJob) -> dict:
             stored.update(truth_test(json.loads(report.read_text())["gap"], stored["truth_held_out"], job.cfg))
             done.write_text(json.dumps(stored, indent=1, default=float))
         return stored
-    c = job.case
     t0 = time.perf_counter()
-    family = datasets.FAMILIES[c.model]
-    if c.band_hz:
-        family = dataclasses.replace(family, band_hz=tuple(c.band_hz))
-    style = datasets.LabStyle(c.excitation, tuple(c.outputs), c.motion, record_s=job.record_s)
-    record = dict(seed=c.seed, periods=PERIODS, style=style, base=c.base)
-    if c.sizes:  # each withheld effect scaled to its drawn size on the records as they will be written
-        c = dataclasses.replace(c, truth=sizing.sized(c.truth, c.model, c.sizes, lambda truth: datasets.effect_sizes(
-            family, c.withheld, truth=truth, **record)))
-    data = datasets.write_dataset(folder / "data", family, c.withheld, truth=c.truth or None, **record)
-    # the user describes the damper's geometry; the messenger's EI and damping (the family's linear parameters)
-    # are what the nominal calibrates
-    linear = FAMILY[c.model].linear
-    described = NominalModel(c.model, {k: v for k, v in c.base.items() if k not in linear}) if c.base else None
+    c, data, described = write_case(job.case, folder / "data", job.record_s)
     written = time.perf_counter() - t0
     # fits an earlier run of this case stored (its outcome removed to diagnose it again): read, not run, so this
     # case's time is not a diagnosis's from scratch

@@ -76,6 +76,7 @@ GLIDE_S = 0.2  # [s] a clamp's stepped sine moves to the next frequency over thi
 # CVODES tolerances of the truth: against 1e-10 / 1e-14 the SDOF records change by at most 1.5e-6 of the
 # output's standard deviation, far below the sensor noise (1e-3 of it and more), in a third less time
 TRUTH_RTOL, TRUTH_ATOL = 1e-8, 1e-12
+OVERSAMPLE = 10  # the truth's rate over the sensor rate (its sensor chain decimates by this)
 
 
 SWEEP_LEVELS = {"SDOFBoucWen": ((10.0, 25.0, 50.0), "N"),  # force amplitude
@@ -189,17 +190,17 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
             stop, keep = (lead + periods + 1) * spp / fs, slice(lead * spp, (lead + periods) * spp)
         physical = {k: v for k, v in truth.items() if k != "sensor_delay"}  # the delay is in the recording
         t, exact, _ = simulate_truth(SyntheticSpec(family.model, signal, stop, fs, list(recorded), physical,
-                                                   oversample=10, rtol=TRUTH_RTOL, atol=TRUTH_ATOL))
+                                                   oversample=OVERSAMPLE, rtol=TRUTH_RTOL, atol=TRUTH_ATOL))
         tangent = {**physical, **family.tangent}
         clean = exact if _same_system(family.model, tangent, physical) else simulate_truth(SyntheticSpec(
-            family.model, signal, stop, fs, list(recorded), tangent, oversample=10, rtol=TRUTH_RTOL,
+            family.model, signal, stop, fs, list(recorded), tangent, oversample=OVERSAMPLE, rtol=TRUTH_RTOL,
             atol=TRUTH_ATOL))[1]
         tk = t[keep] - t[keep][0]
         sigma = {o: _noise_of(family, o, clean[o][keep]) for o in recorded}
         channels += len(recorded)
         for e in member_sq:  # the truth with this member off, the others on (one member: the tangent truth)
             off = clean if len(members) == 1 else simulate_truth(SyntheticSpec(
-                family.model, signal, stop, fs, list(recorded), {**physical, **members[e]}, oversample=10,
+                family.model, signal, stop, fs, list(recorded), {**physical, **members[e]}, oversample=OVERSAMPLE,
                 rtol=TRUTH_RTOL, atol=TRUTH_ATOL))[1]
             member_sq[e] += sum(np.mean((exact[o][keep] - off[o][keep]) ** 2) / sigma[o] ** 2 for o in recorded)
         num = sum(np.mean((exact[o][keep] - clean[o][keep]) ** 2) for o in recorded)

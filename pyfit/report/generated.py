@@ -77,6 +77,7 @@ RESULTS = {
     "docs/results/bench_batch_speedup.md": ("results/bench/batch_speedup.md", "python bench/batch_speedup.py"),
     "docs/results/bench_pool_start.md": ("results/bench/pool_start.md", "python bench/pool_start.py"),
     "docs/results/bench_escape_cost.md": ("results/bench/escape_cost.md", "python bench/escape_cost.py"),
+    "docs/results/bench_sensor_chain.md": ("results/bench/sensor_chain.md", "python bench/sensor_chain.py"),
     "docs/results/bench_fmu_soak.md": ("results/bench/fmu_soak.md", "python bench/fmu_soak.py"),
     "docs/results/bench_eval_speed.md": ("results/bench/eval_speed.md", "python bench/eval_speed.py"),
     "docs/results/bench_diagnose_time.md": ("results/bench/diagnose_time.md", "python bench/diagnose_time.py"),
