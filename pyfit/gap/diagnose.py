@@ -199,6 +199,12 @@ def _load(data_dir, system, cfg: DiagnoseConfig, runner: FmuRunner) -> Dataset:
                    read, clipped)
 
 
+def tried_effects(system, cfg: DiagnoseConfig) -> list[str]:
+    """The effects a diagnosis screens and refits: those `cfg.effects` names, else every effect of the system but
+    the ones offered only on request (systems.Effect.opt_in)."""
+    return cfg.effects or [n for n, e in system.effects.items() if not e.opt_in]
+
+
 def _simulated(runner, records, values: dict, system, cfg: DiagnoseConfig) -> dict:
     """Each of `records` simulated with `values` (record name -> outputs; None where a simulation failed)."""
     return {r.name: sim.simulate(runner, r, values, cfg.upsample, system.lead_periods) for r in records}
@@ -882,7 +888,7 @@ def diagnose(model: str, data_dir, out_dir, cfg: DiagnoseConfig | None = None, f
     _check_signs(system, fmu, cal, cfg, nominal, report.best_calibration_nrmse(gap)[0], data_dir, workers)
     clock.end("where (nominal gap)")
     screening, fits, selected = {}, {}, None
-    effects = cfg.effects or list(system.effects)
+    effects = tried_effects(system, cfg)
     # nothing to attribute when the nominal model fits the held-out files within the noise threshold, unless
     # cfg.refit_within_noise: an effect too weak for that threshold is still told from noise when its refit removes
     # part of the held-out misfit (below). When the nominal fits none of its own calibration files the effects are

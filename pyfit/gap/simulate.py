@@ -17,6 +17,7 @@ from pyfit.runtime.drive import drive
 
 
 SENSOR_DELAY = "sensor_delay"  # candidate parameter [s]: the outputs lag the inputs by it (channel skew)
+SENSOR_GAIN = "sensor_gain"  # candidate parameter [1]: the outputs read (1 + it) times what the model gives
 
 # wall-clock limit of one simulation in a diagnosis [s]: a record simulates in well under a second to a few
 # seconds; a parameter set so stiff that the integrator crawls (a friction smoothed over a tiny velocity beside a
@@ -148,6 +149,7 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
         tolerance = tolerance_of(rec)
     params = dict(params)
     delay = params.pop(SENSOR_DELAY, 0.0)  # not an FMU parameter: a lag of the output channels behind the inputs
+    gain = 1.0 + params.pop(SENSOR_GAIN, 0.0)  # nor this: the output channels' gain over the model's
     inputs, repeat = rec.inputs, 1
     rigid = None
     if rec.support:  # from rest relative to the support: its start moved to rest, the outputs moved back
@@ -163,7 +165,7 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
     if not res.ok:
         return None
     values = res.values if rigid is None else {k: _moved_back(runner, k, v, *rigid) for k, v in res.values.items()}
-    return {k: without_offset(delayed(np.tile(v, repeat), rec.fs, delay, rec.periodic)[rec.first:])
+    return {k: gain * without_offset(delayed(np.tile(v, repeat), rec.fs, delay, rec.periodic)[rec.first:])
             for k, v in values.items()}
 
 

@@ -90,6 +90,7 @@ class Effect:
     # difference between the model and the lab's sensor chain or another simulator, which carries over to the
     # held-out files as well, so it does not tell a gap there (diagnose._detection)
     linear: bool = False
+    opt_in: bool = False  # a candidate only where the diagnosis's `effects` name it (DiagnoseConfig.effects)
 
     @property
     def strengths(self) -> int:
@@ -335,6 +336,14 @@ SENSOR_DELAY = Effect(
     signature="a phase error that grows in proportion to frequency, the same at every level", signal_only=True,
     linear=True)
 
+# the output channels read in another proportion to the inputs than the model says (a sensor's sensitivity off by a
+# per cent or so, an amplifier's gain): a relative gain of up to 10 %, either sign. Linear, and of a damper only (a
+# family whose every parameter is fitted takes a gain up in them); offered where the configuration's effects name it
+SENSOR_GAIN = Effect(
+    "sensor_gain", (Param("sensor_gain", lambda s: (-0.1, 0.0, 0.1)),),
+    signature="a misfit in proportion to the response, the same share at every level and frequency",
+    signal_only=True, linear=True, opt_in=True)
+
 SDOF_EFFECTS = {
     "hysteresis": Effect(
         "hysteresis",
@@ -488,6 +497,7 @@ DAMPER_EFFECTS = {
                               Param("a2", lambda s: (s.nominal["a2"] - 0.03, s.nominal["a2"], s.nominal["a2"] + 0.03))),
         signature="amplitude-independent shift of the modes (the same misfit at every level)", linear=True),
     "sensor_delay": SENSOR_DELAY,
+    "sensor_gain": SENSOR_GAIN,
 }
 
 @dataclass(frozen=True)
@@ -529,8 +539,9 @@ FAMILY = {
                       ("EI", "alpha_pd", "beta_pd"), "EI", None, damper_modal_starts, damper_bounds, damper_stiffness,
                       damper_deflection, ("x1",), ("x_base", "v_base", "a_base"), DAMPER_EFFECTS, 2,
                       ("alpha_pd", "beta_pd"), _damper_stuck_force_of, upsample=2, smooth_inputs=True,
-                      outside="a delay between the channels; the messenger's frequency-dependent loss; a loose "
-                      "clamp's backlash"),
+                      outside="a delay between the channels; a gain between them (a sensor's sensitivity off by a "
+                      "per cent: the candidate sensor_gain, where the configuration's effects name it); the "
+                      "messenger's frequency-dependent loss; a loose clamp's backlash"),
 }
 
 
