@@ -7,7 +7,7 @@ from pyfit.cli import main
 from pyfit.gap.dataset_check import check_dataset, check_text
 from pyfit.gap import diagnose as dg
 from pyfit.gap.diagnose import DiagnoseError
-from pyfit.gap.report import _clipped_lines
+from pyfit.gap.report import clipped_lines
 
 M, C, K = 2.0, 10.0, 1e5  # kg, N·s/m, N/m: f_n = 35.6 Hz
 
@@ -73,7 +73,7 @@ def test_a_sensor_held_at_its_range_limit_is_named_with_its_samples(tmp_path, fm
     runner, system = sdof_system
     clipped = dg._load(tmp_path, system, dg.DiagnoseConfig(), runner).clipped
     assert clipped == {"run2 x_mm": beyond}
-    assert f"run2 x_mm ({beyond} samples)." in "".join(_clipped_lines(clipped))  # the report's line
+    assert f"run2 x_mm ({beyond} samples)." in "".join(clipped_lines(clipped))  # the report's line
 
 
 def test_the_check_command_prints_it_and_stops_before_any_fit(tmp_path, fmu_dir, capsys):

@@ -12,7 +12,7 @@ import numpy as np
 
 from pyfit.gap import localise
 from pyfit.gap.diagnose import DiagnoseConfig, prepare
-from pyfit.gap.report import CLIPPED_NOTE
+from pyfit.gap.report import clipped_lines
 from pyfit.io.data import TO_SI
 
 
@@ -119,9 +119,9 @@ def check_text(c: DatasetCheck) -> str:
             sign = "inverted" if ch.inverted else "as recorded"
             lines.append(f"| {f.name} | {ch.column} | {ch.side} | {ch.unit} | {ch.model_variable} "
                          f"[{ch.model_unit or '—'}] | {ch.rms_si:.4g} | {sign} |")
-    clipped = [f"{f.name} {ch.column} ({ch.clipped} samples)" for f in c.files for ch in f.channels if ch.clipped]
+    clipped = {f"{f.name} {ch.column}": ch.clipped for f in c.files for ch in f.channels if ch.clipped}
     if clipped:
-        lines += ["", f"{CLIPPED_NOTE}: " + ", ".join(clipped) + "."]
+        lines += ["", clipped_lines(clipped)[0]]
     if c.recorded_hz:
         lines += ["", f"Recorded faster and decimated to the dataset's {c.file_hz:g} Hz: "
                   + ", ".join(f"{name} ({hz:g} Hz)" for name, hz in c.recorded_hz.items()) + "."]

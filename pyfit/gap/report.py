@@ -467,7 +467,7 @@ CLIPPED_NOTE = ("Held at the channel's largest or smallest value, as a range lim
                 "amplifier or ADC: no model follows the signal there; a lower level or a wider range records it)")
 
 
-def _clipped_lines(clipped: dict[str, int]) -> list[str]:
+def clipped_lines(clipped: dict[str, int]) -> list[str]:
     """The channels held at an extreme value (pyfit.analysis.signals.clipped_samples), as markdown lines."""
     if not clipped:
         return []
@@ -514,7 +514,7 @@ def markdown(result: dict) -> str:
         f"Calibrated on {', '.join(result['calibration_files'])}; held out: "
         f"{', '.join(result['held_out_files'])}. Levels ordered by {result['level_order']}.",
         ""] + _set_aside_lines(result.get("set_aside", {})) + _voltage_lines(result.get("voltage_channels", [])) \
-        + _clipped_lines(result.get("clipped_channels", {})) \
+        + clipped_lines(result.get("clipped_channels", {})) \
         + _rate_lines(result.get("analysis_rate"))
     lines += [
         f"Held-out gap (NRMSE) of the nominal model: **{g['overall']:.4f}**; noise floor from the data: "

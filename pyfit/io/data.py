@@ -463,8 +463,6 @@ def _text_columns(csv_path: pathlib.Path, side: pathlib.Path, meta: dict, channe
     """The used columns of a text file (the time column's first, if the file has it), the time column's name (or
     None) and the rows above the first sample (error messages count rows from there); `text`: the file's content
     when it is not the file's own text (a worksheet's: _excel_columns)."""
-    if meta["sheet"] is not None and text is None:
-        fail(side, "sheet", f"'{meta['sheet']}' for {csv_path.name}", EXCEL_SHEET, MeasurementError)
     text = read_text(csv_path, MeasurementError) if text is None else text
     head = _header(csv_path, text, list(channels), meta["columns"])
     names, skip = head.names, head.skip
@@ -489,17 +487,14 @@ def _text_columns(csv_path: pathlib.Path, side: pathlib.Path, meta: dict, channe
 
 EXCEL_ALLOWED = ("an Excel workbook (.xlsx or .xlsm) whose sheet (the sidecar's `sheet`, else the first) holds the "
                  "used columns under a header row naming them")
-EXCEL_SHEET = "a sheet of an Excel workbook (.xlsx or .xlsm) only"
+EXCEL_SUFFIXES = (".xlsx", ".xlsm")
 
 
 def _excel_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
     """The used columns of a worksheet (pyfit.io.excel: read as the text of the sheet's CSV export, rows
     numbered as the spreadsheet numbers them), as _text_columns gives a text file's."""
-    try:
-        text = sheet_text(path, meta["sheet"])
-    except ExcelFileError as exc:
-        raise MeasurementError(f"{path}: not readable as an Excel workbook ({exc}); allowed: {EXCEL_ALLOWED}") \
-            from exc
+    text = _opened(path, side, meta, lambda p: sheet_text(p, meta["sheet"]), ExcelFileError, "an Excel workbook",
+                   EXCEL_ALLOWED, clock=True)
     return _text_columns(path, side, meta, channels, text)
 
 
@@ -507,23 +502,25 @@ MAT_ALLOWED = ("a MATLAB file (v4, v6, v7 or v7.3) holding the columns as vector
                "struct ('s.x'), or as the columns of one matrix the sidecar's `columns` names")
 
 
-def _opened(path: pathlib.Path, side: pathlib.Path, meta: dict, read, error: type, kind: str, allowed: str):
-    """A binary measurement file's content as `read` gives it (its `error` refused as not a `kind` file); a
-    sidecar asking for clock stamps, which only text holds, refused."""
-    if meta["time_unit"] == CLOCK:
-        fail(side, "time_unit", f"'{CLOCK}' for {path.name}: clock stamps are text", f"s or ms for a {kind} file's "
-             "time", MeasurementError)
+def _opened(path: pathlib.Path, side: pathlib.Path, meta: dict, read, error: type, kind: str, allowed: str,
+            clock: bool = False):
+    """A binary measurement file's content as `read` gives it (its `error` refused as not `kind`, e.g. 'a MATLAB
+    file'); a sidecar asking for clock stamps refused unless the format holds them (`clock`: a workbook's
+    date-time cells)."""
+    if meta["time_unit"] == CLOCK and not clock:
+        fail(side, "time_unit", f"'{CLOCK}' for {path.name}: clock stamps are text", f"s or ms for {kind}'s time",
+             MeasurementError)
     try:
         return read(path)
     except error as exc:
-        raise MeasurementError(f"{path}: not readable as a {kind} file ({exc}); allowed: {allowed}") from exc
+        raise MeasurementError(f"{path}: not readable as {kind} ({exc}); allowed: {allowed}") from exc
 
 
 def _mat_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
     """The used columns of a MATLAB file (pyfit.io.matlab), as _text_columns gives a text file's: vectors by
     their names, a struct's fields as 'struct.field', or the columns (or rows) of the one matrix whose size
     matches the sidecar's `columns`, by those names."""
-    arrays = _opened(path, side, meta, mat_variables, MatlabFileError, "MATLAB", MAT_ALLOWED)
+    arrays = _opened(path, side, meta, mat_variables, MatlabFileError, "a MATLAB file", MAT_ALLOWED)
     if meta["columns"] is not None:
         k = len(meta["columns"])
         matrices = [n for n, a in arrays.items() if a.ndim == 2 and k in a.shape]
@@ -599,12 +596,12 @@ def _waveform_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channe
 
 def _tdms_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
     """The used channels of an NI TDMS file (pyfit.io.tdms): _waveform_columns."""
-    return _waveform_columns(path, side, meta, channels, tdms_channels, TdmsFileError, "TDMS", TDMS_ALLOWED)
+    return _waveform_columns(path, side, meta, channels, tdms_channels, TdmsFileError, "a TDMS file", TDMS_ALLOWED)
 
 
 def _uff_columns(path: pathlib.Path, side: pathlib.Path, meta: dict, channels: dict[str, Channel]):
     """The used time records of a universal file (pyfit.io.uff): _waveform_columns."""
-    return _waveform_columns(path, side, meta, channels, uff_channels, UffFileError, "universal (UFF 58)",
+    return _waveform_columns(path, side, meta, channels, uff_channels, UffFileError, "a universal (UFF 58) file",
                              UFF_ALLOWED)
 
 
@@ -626,10 +623,13 @@ def read_measurement(csv_path: str | pathlib.Path) -> Measurement:
     meta["time_unit"] = unit_key(meta["time_unit"])  # 'sec', 'msec' as DAQ exports write them
     if meta["time_unit"] not in (*TIME_UNITS, CLOCK):
         fail(side, "time_unit", f"'{meta['time_unit']}' unknown", ", ".join((*TIME_UNITS, CLOCK)), MeasurementError)
+    if meta["sheet"] is not None and csv_path.suffix.lower() not in EXCEL_SUFFIXES:
+        fail(side, "sheet", f"'{meta['sheet']}' for {csv_path.name}", "a sheet of an Excel workbook (.xlsx or "
+             ".xlsm) only", MeasurementError)
     inputs = _channels(side, meta["inputs"], "inputs")
     outputs = _channels(side, meta["outputs"], "outputs")
     read = {".mat": _mat_columns, ".tdms": _tdms_columns, ".uff": _uff_columns, ".unv": _uff_columns,
-            ".xlsx": _excel_columns, ".xlsm": _excel_columns}.get(csv_path.suffix.lower(), _text_columns)
+            **dict.fromkeys(EXCEL_SUFFIXES, _excel_columns)}.get(csv_path.suffix.lower(), _text_columns)
     cols, time_col, skip = read(csv_path, side, meta, {**inputs, **outputs})
     n = len(next(iter(cols.values())))
     if fs is None and not time_col:
@@ -795,7 +795,7 @@ def check_quantities(m: Measurement, model_units: dict[str, str], voltages: bool
 
 
 # a measurement file's extensions, in any case
-DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc", ".mat", ".tdms", ".uff", ".unv", ".xlsx", ".xlsm")
+DATA_SUFFIXES = (".csv", ".txt", ".dat", ".tsv", ".asc", ".mat", ".tdms", ".uff", ".unv", *EXCEL_SUFFIXES)
 
 
 def measurement_files(folder: str | pathlib.Path) -> list[pathlib.Path]:
