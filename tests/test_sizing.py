@@ -57,3 +57,26 @@ def test_a_drawn_case_is_written_with_its_effects_at_the_sizes_drawn(index):
     for effect, wanted in case.sizes.items():
         assert sizing.SIZE_RANGE[0] <= wanted <= sizing.SIZE_RANGE[1]
         assert got[effect] == pytest.approx(wanted, rel=0.25)
+
+
+def test_a_case_s_records_are_the_same_whether_its_truths_are_simulated_again_or_reused(tmp_path, monkeypatch):
+    """A drawn SDOF case with a cubic spring, written as a campaign writes it (sized in rounds, 1.5 s records): the
+    spring's tangent truth (the spring off) is the same in every round, so the reference simulates it once, and
+    the files are byte for byte those written when every truth is simulated again."""
+    case = next(c for c in campaign.draw(60, seed=11) if c.withheld == "cubic_stiffness" and c.excitation == "noise")
+    calls = []
+    simulate = datasets.simulate_truth
+    monkeypatch.setattr(datasets, "simulate_truth", lambda spec: calls.append(spec.params) or simulate(spec))
+    written = {}
+    for kept in (datasets.TRUTHS_KEPT, 0):
+        monkeypatch.setattr(datasets, "TRUTHS_KEPT", kept)
+        datasets._truths.clear()
+        calls.clear()
+        _, data, _ = campaign.write_case(case, tmp_path / f"kept{kept}", record_s=1.5)
+        written[kept] = ({p.name: p.read_bytes() for p in sorted(data.glob("level*"))}, len(calls),
+                         sum(c["k3"] == 0.0 for c in calls))
+    (reused, n_reused, tangent_reused), (again, n_again, tangent_again) = written.values()
+    assert reused == again and len(reused) == 6
+    levels, rounds = 3, sizing.ROUNDS + 1  # the sizing's rounds and the records written last
+    assert (n_again, tangent_again) == (2 * levels * rounds, levels * rounds)
+    assert (n_reused, tangent_reused) == (levels * (rounds + 1), levels)

@@ -11,8 +11,10 @@ trailing period (filter edge) are dropped, so each file holds steady-state perio
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import pathlib
+import pickle
 import tempfile
 from dataclasses import dataclass
 
@@ -135,6 +137,28 @@ def _truth_params(family: Family, effect: str, base: dict, truth: dict | None = 
     return {**family.linear, **base, **extra}
 
 
+TRUTHS_KEPT = 16  # the different truths last used that a process keeps (pyfit.gap.datasets._truth)
+_truths: dict[str, tuple] = {}
+
+
+def _truth(spec: SyntheticSpec) -> tuple:
+    """simulate_truth(spec), reused while it is among the TRUTHS_KEPT different ones this process used last: a
+    case's sizing writes its records several times (pyfit.gap.sizing), and a damper effect's tangent truth (the
+    effect off) is the same whatever its strength. The same model parameters, signal, record and sensor chain give
+    the same simulation, so a reused result is the one simulating again would give."""
+    from pyfit.reference.models import by_name
+
+    key = hashlib.sha256(pickle.dumps((spec.model, by_name(spec.model).param_vector(spec.params), spec.excitation,
+                                       spec.stop_time, spec.sample_rate_hz, spec.outputs, spec.noise_std,
+                                       spec.oversample, spec.seed, spec.solver, spec.anti_alias,
+                                       spec.passband_ripple_db, spec.rtol, spec.atol))).hexdigest()
+    result = _truths.pop(key, None) or simulate_truth(spec)
+    _truths[key] = result  # the last used last
+    while len(_truths) > TRUTHS_KEPT:
+        _truths.pop(next(iter(_truths)))
+    return result
+
+
 def _same_system(model: str, a: dict, b: dict) -> bool:
     """Whether two parameter sets give the reference model the same parameter vector (the same simulation: a
     null truth is its own tangent truth)."""
@@ -189,17 +213,17 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
             signal = PeriodicSignal(multisine(spp, fs, f0, f1, level, seed, odd=True), fs)
             stop, keep = (lead + periods + 1) * spp / fs, slice(lead * spp, (lead + periods) * spp)
         physical = {k: v for k, v in truth.items() if k != "sensor_delay"}  # the delay is in the recording
-        t, exact, _ = simulate_truth(SyntheticSpec(family.model, signal, stop, fs, list(recorded), physical,
+        t, exact, _ = _truth(SyntheticSpec(family.model, signal, stop, fs, list(recorded), physical,
                                                    oversample=OVERSAMPLE, rtol=TRUTH_RTOL, atol=TRUTH_ATOL))
         tangent = {**physical, **family.tangent}
-        clean = exact if _same_system(family.model, tangent, physical) else simulate_truth(SyntheticSpec(
+        clean = exact if _same_system(family.model, tangent, physical) else _truth(SyntheticSpec(
             family.model, signal, stop, fs, list(recorded), tangent, oversample=OVERSAMPLE, rtol=TRUTH_RTOL,
             atol=TRUTH_ATOL))[1]
         tk = t[keep] - t[keep][0]
         sigma = {o: _noise_of(family, o, clean[o][keep]) for o in recorded}
         channels += len(recorded)
         for e in member_sq:  # the truth with this member off, the others on (one member: the tangent truth)
-            off = clean if len(members) == 1 else simulate_truth(SyntheticSpec(
+            off = clean if len(members) == 1 else _truth(SyntheticSpec(
                 family.model, signal, stop, fs, list(recorded), {**physical, **members[e]}, oversample=OVERSAMPLE,
                 rtol=TRUTH_RTOL, atol=TRUTH_ATOL))[1]
             member_sq[e] += sum(np.mean((exact[o][keep] - off[o][keep]) ** 2) / sigma[o] ** 2 for o in recorded)
