@@ -1,7 +1,7 @@
 """Withheld-effect datasets: measurement files (theory §5) from a truth model that contains one effect
 the nominal model lacks (or none: null cases), at three excitation levels.
 
-No inverse crime: the truth is the CasADi reference integrated by CVODES (rtol 1e-10) at 10x the sensor
+No inverse crime: the truth is the CasADi reference integrated by CVODES (TRUTH_RTOL) at 10x the sensor
 rate, with the excitation as a continuous sum of sines, seen through a sensor chain (zero-phase FIR
 anti-alias filter and decimation) with noise; the diagnosis fits the FMU (another implementation, another
 integrator) at the sensor rate. The excitation is a random-odd multisine (odd lines only, one in four
@@ -214,7 +214,7 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
             stop, keep = (lead + periods + 1) * spp / fs, slice(lead * spp, (lead + periods) * spp)
         physical = {k: v for k, v in truth.items() if k != "sensor_delay"}  # the delay is in the recording
         t, exact, _ = _truth(SyntheticSpec(family.model, signal, stop, fs, list(recorded), physical,
-                                                   oversample=OVERSAMPLE, rtol=TRUTH_RTOL, atol=TRUTH_ATOL))
+                                           oversample=OVERSAMPLE, rtol=TRUTH_RTOL, atol=TRUTH_ATOL))
         tangent = {**physical, **family.tangent}
         clean = exact if _same_system(family.model, tangent, physical) else _truth(SyntheticSpec(
             family.model, signal, stop, fs, list(recorded), tangent, oversample=OVERSAMPLE, rtol=TRUTH_RTOL,
