@@ -74,16 +74,16 @@ def main():
             if args.fits:
                 print(f"{case}:")
                 print_fits(pathlib.Path(tmp) / "out" / "fits")
-        stages = ", ".join(f"{k} {v:.0f} s" for k, v in rep["stage_s"].items())
-        rate = rep["analysis_rate"]
+        stages = ", ".join(f"{k} {v:.0f} s" for k, v in rep.stage_s.items())
+        rate = rep.analysis_rate
         same = SLOWER.get(case)
         analysed = (f"analysed at {rate['file_hz'] / rate['factor']:g} Hz, FMU driven at "
                     f"{rate['file_hz'] / rate['factor'] * rate['drive_upsample']:g} Hz, "
                     + (f"{wall / walls[same]:.2f} x the {FAMILIES[model].fs:g} Hz case's time, "
                        if same in walls else "") if same else "")
-        report.line(f"{opening}{len(rep['ranking'])} candidates and combinations refitted): {wall:.0f} s "
+        report.line(f"{opening}{len(rep.ranking)} candidates and combinations refitted): {wall:.0f} s "
                     f"({analysed}{wall / GOAL_S[model]:.2f} x the goal of {GOAL_S[model]:.0f} s; {stages}); "
-                    f"verdict: {rep['verdict']}")
+                    f"verdict: {rep.sentence}")
 
 
 if __name__ == "__main__":

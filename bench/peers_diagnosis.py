@@ -56,7 +56,7 @@ def main():
                 t0 = time.perf_counter()
                 rep = diagnose("sdof", data, pathlib.Path(tmp) / "out" / data.name, fmu_dir=args.fmus, workers=2,
                                progress=False)
-                verdicts.append((case, effect, DIAGNOSE, rep["chosen_effect"], time.perf_counter() - t0))
+                verdicts.append((case, effect, DIAGNOSE, rep.chosen_name, time.perf_counter() - t0))
                 print(case, {m: n for c, _, m, n, _ in verdicts if c == case}, flush=True)
     methods = [DIAGNOSE, *peers.METHODS]
     rows = []

@@ -16,7 +16,7 @@ from pyfit.report.generated import BenchReport
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 POOLS = """
 import concurrent.futures as cf, multiprocessing, time
-from pyfit.gap.diagnose import _stem
+from pyfit.gap.search import stem as _stem
 from pyfit.runtime.batch import map_tasks
 items = ["a + b", "c", "d + e", "f"]
 t0 = time.perf_counter()

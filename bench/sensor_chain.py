@@ -90,7 +90,7 @@ def main():
             rep = diagnose("damper", variants[name], tmp / f"diagnosis_{len(runs)}", DiagnoseConfig(), fmu_dir,
                            workers=args.workers, progress=False, nominal=described)
             runs[name] = (time.perf_counter() - t0, rep)
-    floor = runs["as written"][1]["gap"]["noise_floor_scaled"]
+    floor = runs["as written"][1].gap.noise_floor_scaled
     above = DiagnoseConfig().extend_factor * floor
     report.line(f"damper campaign case {args.case} (seed 0, stepped sines of 35 s; {case.withheld} withheld at "
                 f"{', '.join(f'{v:.2f}' for v in (case.sizes or {}).values())} x the noise; clamp motion recorded: "
@@ -100,9 +100,9 @@ def main():
                  "over the noise floor"], [[n, f"{v:.5f}", f"{v / floor:.2f}"] for n, v in misfits.items()])
     rows = []
     for name, (wall, rep) in runs.items():
-        stages = rep["stage_s"]
+        stages = rep.stage_s
         rows.append([name, f"{wall:.0f}", f"{stages['refits with each effect']:.0f}",
-                     f"{stages['combinations of effects']:.0f}", rep["verdict"]])
+                     f"{stages['combinations of effects']:.0f}", rep.sentence])
     report.table(f"Its diagnosis on {args.workers} workers", ["records", "wall [s]", "refits with each effect [s]",
                  "combinations of effects [s]", "verdict"], rows)
 

@@ -157,3 +157,26 @@ def pytest_sessionfinish(session, exitstatus):
     MEASURED_TABLE.write_text(_table(sorted(rows, key=lambda m: (m["test"].split("::")[0], m["test"])))
                               + f"\nThe default run (`python -m pytest`): {n_passed} tests passed in {wall:.0f} s "
                                 f"on {os.cpu_count()} cores.\n")
+
+
+def check_report(path: pathlib.Path) -> None:
+    """A report.json the diagnosis wrote: valid against the schema the package ships (pyfit/gap/report.schema.json),
+    and read back into the same Diagnosis (its JSON written again is the file's)."""
+    import json
+
+    import jsonschema
+
+    from pyfit.gap.result import SCHEMA, Diagnosis
+
+    written = json.loads(path.read_text())
+    jsonschema.validate(written, json.loads(SCHEMA.read_text()))
+    assert Diagnosis.from_json(written).to_json() == written, path
+
+
+@pytest.fixture(scope="session", autouse=True)
+def every_report_checked(tmp_path_factory):
+    """Every report.json a test of this run made (under the run's temporary folders), checked once the tests of this
+    worker end: check_report."""
+    yield
+    for path in sorted(tmp_path_factory.getbasetemp().rglob("report.json")):
+        check_report(path)

@@ -5,6 +5,7 @@ import json
 import numpy as np
 
 from pyfit.gap import datasets
+from pyfit.gap.result import Diagnosis
 from pyfit.gap import diagnose as dg
 
 # CI budgets: fewer evaluations per fit, and the forward selection from the best single effect only with three
@@ -39,13 +40,13 @@ def found_where_it_acts(root, fmu_dir, effect, measured):
     change = json.loads((data / "truth.json").read_text())["rms_change"]["25"]["rms"]
     assert 0.05 <= abs(change) <= 0.30
     rep = dg.diagnose("sdof", data, root / f"out_{effect}", CI, fmu_dir, workers=2, progress=False)
-    assert rep["chosen_effect"] == effect and rep["ranking"][0]["effect"] == effect
+    assert rep.chosen_name == effect and rep.ranking[0].effect == effect
     measured(f"SDOF gap diagnosis, {effect} withheld (CI budgets): held-out shrink of the chosen effect [%]",
-             rep["ranking"][0]["shrink_pct"], 80.0, at_least=True)
-    lo, hi = rep["gap"]["worst_band_hz"]
+             rep.ranking[0].shrink_pct, 80.0, at_least=True)
+    lo, hi = rep.gap.worst_band_hz
     assert lo <= F0 <= hi
-    assert rep["gap"]["overall"] > 5 * rep["gap"]["noise_floor"]
-    assert rep["clipped_channels"] == {}  # the noisy records within range: no channel taken for a clipped one
+    assert rep.gap.overall > 5 * rep.gap.noise_floor
+    assert rep.clipped_channels == {}  # the noisy records within range: no channel taken for a clipped one
     assert (root / f"out_{effect}" / "report.md").is_file()
 
 
@@ -57,9 +58,9 @@ def strength_recovered(root, fmu_dir, effect, strength, measured):
     log-scaled, but barely shapes these displacement records)."""
     truth = json.loads((case(root, effect) / "truth.json").read_text())["params"][strength]
     out = diagnosed(root, fmu_dir, effect)
-    rep = json.loads((out / "report.json").read_text())
-    best = rep["ranking"][0]
-    assert best["effect"] == effect and best["shrink_pct"] >= 95.0  # measured 100 % on each
-    assert rep["confidence"] is None and "Confidence" not in (out / "report.md").read_text()
+    rep = Diagnosis.read(out / "report.json")
+    best = rep.ranking[0]
+    assert best.effect == effect and best.shrink_pct >= 95.0  # measured 100 % on each
+    assert rep.confidence is None and "Confidence" not in (out / "report.md").read_text()
     measured(f"SDOF gap diagnosis, {effect} withheld (CI budgets): |fitted {strength} / truth − 1|",
-             abs(best["params"][strength] / truth - 1), 0.02)
+             abs(best.params[strength] / truth - 1), 0.02)

@@ -103,12 +103,12 @@ def fast_sdof(tmp_path_factory):
 def test_a_fast_record_is_diagnosed_at_a_lower_rate_with_the_same_result(fast_sdof, fmu_dir, measured):
     root, data, truth, fs = fast_sdof
     rep = dg.diagnose("sdof", data, root / "out", CI, fmu_dir, workers=2, progress=False)
-    rate = rep["analysis_rate"]
+    rate = rep.analysis_rate
     assert rate["factor"] == 2 and rate["file_hz"] == pytest.approx(fs)
     assert fs / rate["factor"] >= RATE_FACTOR * rate["top_hz"] and 58.0 <= rate["top_hz"] <= 63.0  # the sweep's 60 Hz
     assert rate["drive_upsample"] == 2  # 2.6-3.4 kHz grid: at least the 2 kHz the SDOF family's 500 Hz files have
-    assert rep["chosen_effect"] == "cubic_stiffness", rep["verdict"]
-    fitted = rep["ranking"][0]["params"]
+    assert rep.chosen_name == "cubic_stiffness", rep.sentence
+    fitted = rep.ranking[0].params
     measured("SDOF recorded at 42-55 x its top frequency, decimated: |k3'/k3 - 1|",
              abs(fitted["k3"] / truth["k3"] - 1.0), 0.02)
     measured("SDOF recorded at 42-55 x its top frequency, decimated: |k'/k - 1|", abs(fitted["k"] / truth["k"] - 1.0),

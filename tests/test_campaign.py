@@ -294,23 +294,13 @@ def test_a_resumed_or_extended_campaign_states_the_earlier_runs_wall_time():
     assert campaign.wall_of_runs(this, 40, None) == this
 
 
-def test_the_truth_s_own_test_is_the_report_s_and_completes_a_stored_outcome(tmp_path):
+def test_the_truth_s_own_test_is_the_report_s(tmp_path):
     """campaign.truth_test: the truth's held-out shrink of the gap against the report's reference (the truth's own
-    misfit when lower: the report takes the least of every model's); a stored outcome without it is completed
-    from the case's stored report when the campaign reads it again (no case re-diagnosed)."""
+    misfit when lower: the report takes the least of every model's)."""
     cfg = dg.DiagnoseConfig()
-    gap = {"overall": 0.0053, "shrink_reference": 0.0048}
-    assert campaign.truth_test(gap, 0.0050, cfg) == {"truth_shrink_pct": pytest.approx(60.0),
-                                                     "min_shrink_pct": cfg.min_shrink_pct}
-    assert campaign.truth_test(gap, 0.0040, cfg)["truth_shrink_pct"] == pytest.approx(100.0)
-    case = campaign.draw(4, 0)[3]
-    folder = tmp_path / "case0003"
-    (folder / "diagnosis").mkdir(parents=True)
-    (folder / "diagnosis" / "report.json").write_text(json.dumps({"gap": gap}))
-    (folder / "outcome.json").write_text(json.dumps({"named": "none", "truth_held_out": 0.0050}))
-    outcome = campaign.run_case(campaign.CaseJob(case, str(tmp_path), "no-fmus-needed", 6.0, cfg))
-    assert outcome["truth_shrink_pct"] == pytest.approx(60.0) and outcome["named"] == "none"
-    assert json.loads((folder / "outcome.json").read_text())["truth_shrink_pct"] == pytest.approx(60.0)
+    assert campaign.truth_test(0.0053, 0.0048, 0.0050, cfg) == {"truth_shrink_pct": pytest.approx(60.0),
+                                                                 "min_shrink_pct": cfg.min_shrink_pct}
+    assert campaign.truth_test(0.0053, 0.0048, 0.0040, cfg)["truth_shrink_pct"] == pytest.approx(100.0)
 
 
 @pytest.mark.slow

@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 
 from pyfit.gap import campaign, datasets
+from pyfit.gap.result import Verdict
 from pyfit.gap.diagnose import DiagnoseConfig, diagnose
 from pyfit.gap.systems import FAMILY
 from pyfit.io.nominal import NominalModel
@@ -41,11 +42,11 @@ def test_a_nominal_with_every_resonance_outside_the_band_is_calibrated_from_the_
     data = datasets.write_dataset(tmp_path / "data", family, "none", seed=11, periods=2, base=geometry,
                                   style=datasets.LabStyle("noise", ("acc_x1", "acc_x2"), "xva", record_s=6.0))
     rep = _calibrated_nominal(data, tmp_path / "diagnosis", fmu_dir, described)
-    assert rep["verdict"] == "no significant gap"
+    assert rep.verdict is Verdict.NO_GAP
     # EI sets every resonance (f ∝ √EI); the nominal fit of these noise records resolves it to about 1e-5:
     # 0.2 % of EI (0.1 % of frequency) leaves room for other noise seeds, not for a start left at the default
     measured("damper described without EI, default EI's resonances outside the band: |calibrated EI / true EI - 1|",
-             abs(rep["nominal"]["params"]["EI"] / geometry["EI"] - 1.0), 0.002)
+             abs(rep.nominal.params["EI"] / geometry["EI"] - 1.0), 0.002)
 
 
 def test_a_start_with_the_right_stiffness_but_damping_far_off_is_not_lost_to_a_start_below_the_band(
@@ -61,9 +62,9 @@ def test_a_start_with_the_right_stiffness_but_damping_far_off_is_not_lost_to_a_s
                                                                           case.motion, record_s=6.0))
     described = {k: v for k, v in case.base.items() if k not in FAMILY["damper"].linear}
     rep = _calibrated_nominal(data, tmp_path / "diagnosis", fmu_dir, described)
-    assert rep["verdict"] == "no significant gap"
+    assert rep.verdict is Verdict.NO_GAP
     # measured: 1.5e-5 (EI) and 5e-4 (alpha_pd, which the noise resolves less well than the stiffness)
     measured("heavily damped damper on noise records, a wrong-EI start misfitting least: |calibrated EI / true "
-             "EI - 1|", abs(rep["nominal"]["params"]["EI"] / case.base["EI"] - 1.0), 0.002)
+             "EI - 1|", abs(rep.nominal.params["EI"] / case.base["EI"] - 1.0), 0.002)
     measured("the same: |calibrated alpha_pd / true alpha_pd - 1|",
-             abs(rep["nominal"]["params"]["alpha_pd"] / case.base["alpha_pd"] - 1.0), 0.02)
+             abs(rep.nominal.params["alpha_pd"] / case.base["alpha_pd"] - 1.0), 0.02)

@@ -62,8 +62,8 @@ def test_a_strong_spring_and_loop_on_a_sweep_are_named_from_the_envelopes(tmp_pa
     described = NominalModel("damper", {k: v for k, v in case.base.items() if k not in FAMILY["damper"].linear})
     rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False,
                       nominal=described)
-    assert sorted((rep["chosen_effect"] or "").split(" + ")) == ["cubic_stiffness", "hysteresis"], rep["verdict"]
-    fitted = next(d for d in rep["ranking"] if d["effect"] == rep["chosen_effect"])["params"]
+    assert sorted(rep.chosen) == ["cubic_stiffness", "hysteresis"], rep.sentence
+    fitted = next(d for d in rep.ranking if d.effect == rep.chosen_name).params
     for name in ("k_cs1", "k_cs2"):
         measured(f"damper campaign case 24 (cubic springs + loop on sweeps), {name} from the envelope-led refit: "
                  "|fit / truth - 1|", abs(fitted[name] / case.truth[name] - 1), 0.02)

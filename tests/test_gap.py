@@ -2,12 +2,13 @@
 damping (hysteresis and Coulomb friction: test_gap_loop_friction.py): the withheld effect ranked first, the
 largest misfit around the resonance it shifts, at least 80 % of the held-out gap removed, its strength
 recovered; an interrupted diagnosis resumes; a close runner-up gets a level and band to measure."""
-import json
 
 import pytest
 
 from gap_cases import CI, case, diagnosed, found_where_it_acts, strength_recovered
 from pyfit.gap import diagnose as dg
+from pyfit.gap import store
+from pyfit.gap.result import Diagnosis
 
 
 @pytest.fixture(scope="module")
@@ -27,17 +28,17 @@ def test_chosen_effect_recovers_the_withheld_strength(data_root, fmu_dir, effect
 
 def test_interrupted_diagnosis_resumes_from_finished_refits(data_root, fmu_dir, monkeypatch):
     out = diagnosed(data_root, fmu_dir, "quadratic_damping")
-    before = json.loads((out / "report.json").read_text())
+    before = Diagnosis.read(out / "report.json")
     (out / "fits" / "cubic_stiffness.json").unlink()  # as if killed while that refit ran
     calls = []
-    real = dg.run_fit
-    monkeypatch.setattr(dg, "run_fit", lambda task: calls.append(task.effect) or real(task))
+    real = store.run_fit
+    monkeypatch.setattr(store, "run_fit", lambda task: calls.append(task.effect) or real(task))
     rep = dg.diagnose("sdof", case(data_root, "quadratic_damping"), out, CI, fmu_dir, workers=1, progress=False)
     assert calls == ["cubic_stiffness"]
-    after = {r["effect"]: r["shrink_pct"] for r in rep["ranking"]}
-    for r in before["ranking"]:
-        if r["effect"] != "cubic_stiffness":
-            assert after[r["effect"]] == pytest.approx(r["shrink_pct"], abs=1e-9)
+    after = {r.effect: r.shrink_pct for r in rep.ranking}
+    for r in before.ranking:
+        if r.effect != "cubic_stiffness":
+            assert after[r.effect] == pytest.approx(r.shrink_pct, abs=1e-9)
 
 
 def test_a_refit_is_the_same_on_one_thread_as_on_two(data_root, sdof_system, monkeypatch):
@@ -64,12 +65,12 @@ def test_close_runner_up_gets_a_level_and_band_to_measure(data_root, fmu_dir):
     out = diagnosed(data_root, fmu_dir, "quadratic_damping")
     cfg = dg.DiagnoseConfig(nominal_budget=30, refit_budget=60, close_points=100.0)
     rep = dg.diagnose("sdof", case(data_root, "quadratic_damping"), out, cfg, fmu_dir, workers=1, progress=False)
-    sep = rep["separation"]
-    assert rep["runner_up_close"] and sep["between"] == [r["effect"] for r in rep["ranking"][:2]]
+    sep = rep.separation
+    assert rep.runner_up_close and sep.between == tuple(r.effect for r in rep.ranking[:2])
     # the candidates were simulated at the three measured levels and beyond them (x0.3, x2)
-    assert len(sep["levels"]) == 5
-    best = sep["measure_next"]
-    assert best["difference_nrmse"] == max(d["difference_nrmse"] for d in sep["levels"]) > 0
+    assert len(sep.levels) == 5
+    best = sep.measure_next
+    assert best["difference_nrmse"] == max(d["difference_nrmse"] for d in sep.levels) > 0
     assert best["band_hz"][0] < best["band_hz"][1]
     assert "score close" in (out / "report.md").read_text()
 
@@ -130,9 +131,9 @@ def test_a_diagnosis_runs_its_linear_algebra_on_one_blas_thread(tmp_path, monkey
     assert seen and set(seen) == {1}
     assert set(after) == {2}  # the caller's setting is back once the diagnosis returns
     # and so does each fit a diagnosis runs in a worker process, which starts with the machine's default
-    monkeypatch.setattr(dg, "run_fit", probe)
+    monkeypatch.setattr(store, "run_fit", probe)
     seen.clear()
     with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
         with pytest.raises(RuntimeError, match="stopped by the test"):
-            dg._fit_and_store((None, tmp_path / "fit.json", "key", "a stage"))
+            store.fit_and_store((None, tmp_path / "fit.json", "key", "a stage"))
     assert seen and set(seen) == {1}

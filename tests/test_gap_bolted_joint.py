@@ -75,20 +75,20 @@ def test_a_bolted_joint_is_taken_nearest_by_the_loop_and_what_is_left_is_told(tm
     truth = bolted_beam(tmp_path / "data", seed=20261205)
     rep = dg.diagnose("sdof", tmp_path / "data", tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2,
                       progress=False)
-    best = rep["ranking"][0]
-    assert best["members"] == ["hysteresis"] or rep["chosen_effect"] and "hysteresis" in rep["chosen_effect"], \
-        [(r["effect"], r["shrink_pct"]) for r in rep["ranking"]]
+    best = rep.ranking[0]
+    assert best.members == ("hysteresis",) or "hysteresis" in rep.chosen, \
+        [(r.effect, r.shrink_pct) for r in rep.ranking]
     measured("bolted joint (Iwan, random), 0-40 Hz sweeps in volts: the loop's held-out shrink [%]",
-             best["shrink_pct"], 50.0, at_least=True)
+             best.shrink_pct, 50.0, at_least=True)
     nominal = json.loads((tmp_path / "out" / "fits" / "nominal.json").read_text())["fit"]["calibration_nrmse"]
     for fit in (tmp_path / "out" / "fits").glob("*.json"):
         refit = json.loads(fit.read_text()).get("fit")
         assert refit is None or refit["calibration_nrmse"] <= nominal * (1 + 1e-9), fit.name
-    if rep["chosen_effect"] is None:  # the loop's form leaves more than the noise: said, in numbers
+    if rep.chosen_name is None:  # the loop's form leaves more than the noise: said, in numbers
         text = (tmp_path / "out" / "report.md").read_text()
         assert f"best candidate {best['effect']}: held-out NRMSE {best['heldout_gap_after']:.4f}" in text
         assert "a bolted joint's micro-slip" in text and "--candidates FILE.toml" in text
-    bands = [b["band_hz"] for b in rep["gap"]["by_band"]]
+    bands = [b.band_hz for b in rep.gap.by_band]
     assert bands[0][0] >= bands[-1][1] / 32.0 * (1 - 1e-9)
-    lo, hi = rep["gap"]["worst_band_hz"]
+    lo, hi = rep.gap.worst_band_hz
     assert lo <= truth["f_n"] * 1.05 and truth["f_n"] * (1 - truth["share"]) ** 0.5 * 0.95 <= hi

@@ -5,7 +5,6 @@ sensor noise on force and displacement, written the way a DAQ exports: comment l
 mm, an extra temperature column, a time column rounded to 6 significant digits, the input band up to
 0.65 x Nyquist (no quiet band above it). At two scales: the SDOF benchmark's, and an electronic
 oscillator's (volts read as m and N: k = 1 N/m, m = 7e-6 kg)."""
-import json
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,6 +13,7 @@ import scipy.signal as ss
 from scipy.integrate import solve_ivp
 
 from pyfit.gap import diagnose as dg
+from pyfit.gap.result import Diagnosis
 
 FS = 610.35  # Hz, a DAQ's rate
 SEGMENT_S = 20.0
@@ -86,21 +86,21 @@ def test_broadband_segments_of_a_duffing_oscillator_are_diagnosed_as_cubic_stiff
     data, scale = duffing_dataset
     osc = SCALES[scale]
     rep = dg.diagnose("sdof", data, tmp_path / "out", fmu_dir=fmu_dir, workers=2, progress=False)
-    assert rep["verdict"] == "gap explained by cubic_stiffness"
-    assert rep["gap"]["noise_floor_method"] == ["local polynomial, lowest level"]
-    assert rep["level_order"] == "input RMS"  # the sidecars give labels only: the segments order by their RMS
+    assert rep.chosen == ("cubic_stiffness",)
+    assert rep.gap.noise_floor_method == ("local polynomial, lowest level",)
+    assert rep.level_order == "input RMS"  # the sidecars give labels only: the segments order by their RMS
     assert "Levels ordered by input RMS." in (tmp_path / "out" / "report.md").read_text()
-    best = rep["ranking"][0]
+    best = rep.ranking[0]
     measured(f"Duffing broadband segments ({scale} scale; independent solver, DAQ-style files): held-out shrink [%]",
-             best["shrink_pct"], 80.0, at_least=True)
+             best.shrink_pct, 80.0, at_least=True)
     measured(f"Duffing broadband segments ({scale} scale): |fitted k3 / true k3 - 1|",
-             abs(best["params"]["k3"] / osc.k3 - 1), 0.05)
+             abs(best.params["k3"] / osc.k3 - 1), 0.05)
     # the floor: the sensor noise of the held-out segment, plus the measured force's noise through the model
-    held = next(f for f in rep["gap"]["by_level"] if f["held_out"])
-    y = np.genfromtxt(data / f"{held['file']}.csv", delimiter=",", skip_header=3)[:, 2] * 1e-3
+    held = next(f for f in rep.gap.by_level if f.held_out)
+    y = np.genfromtxt(data / f"{held.file}.csv", delimiter=",", skip_header=3)[:, 2] * 1e-3
     true_sensor_floor = osc.noise_y / np.sqrt(np.mean(y**2))
     measured(f"Duffing broadband segments ({scale} scale): noise floor / sensor noise alone (>= 1: the force "
              "noise and the distortion add)",
-             rep["gap"]["noise_floor"] / true_sensor_floor, osc.floor_ratio_max)
-    assert rep["gap"]["noise_floor"] >= true_sensor_floor
-    assert json.loads((tmp_path / "out" / "report.json").read_text())["verdict"] == rep["verdict"]
+             rep.gap.noise_floor / true_sensor_floor, osc.floor_ratio_max)
+    assert rep.gap.noise_floor >= true_sensor_floor
+    assert Diagnosis.read(tmp_path / "out" / "report.json").to_json() == rep.to_json()

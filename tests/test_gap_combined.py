@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from pyfit.gap import campaign, datasets, selection
+from pyfit.gap.result import Diagnosis, Verdict
 from pyfit.gap import diagnose as dg
 from pyfit.gap.systems import DAMPER_EFFECTS, SDOF_EFFECTS, Scale
 
@@ -51,9 +52,9 @@ def test_sdof_hysteresis_of_a_random_shape_is_named(tmp_path, fmu_dir, case, mea
     assert _starts_hold_none_of(truth, SDOF_EFFECTS["hysteresis"])
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "hysteresis", seed=case, periods=2, truth=truth)
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert rep["chosen_effect"] == "hysteresis", (truth, rep["verdict"], rep["ranking"][:2])
+    assert rep.chosen_name == "hysteresis", (truth, rep.sentence, rep.ranking[:2])
     measured(f"SDOF hysteresis of a random loop shape ({', '.join(f'{k} = {v:.3g}' for k, v in truth.items())}): "
-             "held-out shrink [%]", rep["ranking"][0]["shrink_pct"], 90.0, at_least=True)
+             "held-out shrink [%]", rep.ranking[0].shrink_pct, 90.0, at_least=True)
 
 
 def test_a_strong_element_with_a_wide_loop_on_long_sweeps_is_named_alone(tmp_path, fmu_dir, measured):
@@ -73,10 +74,10 @@ def test_a_strong_element_with_a_wide_loop_on_long_sweeps_is_named_alone(tmp_pat
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "hysteresis", seed=3, truth=truth,
                                   style=datasets.LabStyle(excitation="sweep"))
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert rep["chosen_effect"] == "hysteresis", (truth, rep["verdict"], rep["ranking"][:3])
-    best = rep["ranking"][0]
-    measured("SDOF wide loop on 35 s sweeps: held-out NRMSE over the noise floor", best["heldout_gap_after"]
-             / rep["gap"]["noise_floor"], 1.2)
+    assert rep.chosen_name == "hysteresis", (truth, rep.sentence, rep.ranking[:3])
+    best = rep.ranking[0]
+    measured("SDOF wide loop on 35 s sweeps: held-out NRMSE over the noise floor", best.heldout_gap_after
+             / rep.gap.noise_floor, 1.2)
 
 
 def test_a_moderate_element_with_a_very_wide_loop_on_short_sweeps_is_named_alone(tmp_path, fmu_dir, measured):
@@ -95,9 +96,9 @@ def test_a_moderate_element_with_a_very_wide_loop_on_short_sweeps_is_named_alone
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "hysteresis", seed=6, truth=truth,
                                   style=datasets.LabStyle(excitation="sweep", outputs=("a",), record_s=6.0))
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert rep["chosen_effect"] == "hysteresis", (truth, rep["verdict"], rep["ranking"][:3])
+    assert rep.chosen_name == "hysteresis", (truth, rep.sentence, rep.ranking[:3])
     measured("SDOF very wide loop on 6 s sweeps: |fitted nu - withheld nu|",
-             abs(rep["ranking"][0]["params"]["nu"] - nu), 0.15)
+             abs(rep.ranking[0].params["nu"] - nu), 0.15)
 
 
 def test_a_weak_element_with_a_narrow_loop_is_named_and_its_strength_recovered(tmp_path, fmu_dir, measured):
@@ -114,10 +115,10 @@ def test_a_weak_element_with_a_narrow_loop_is_named_and_its_strength_recovered(t
     assert _starts_hold_none_of(truth, SDOF_EFFECTS["hysteresis"])
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "hysteresis", seed=4, truth=truth)
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert rep["chosen_effect"] == "hysteresis", (truth, rep["verdict"], rep["ranking"][:3])
-    best = rep["ranking"][0]
+    assert rep.chosen_name == "hysteresis", (truth, rep.sentence, rep.ranking[:3])
+    best = rep.ranking[0]
     measured("SDOF weak narrow loop: fitted alpha relative to the withheld value",
-             abs(best["params"]["alpha"] / truth["alpha"] - 1), 0.05)
+             abs(best.params["alpha"] / truth["alpha"] - 1), 0.05)
 
 
 def test_sdof_coulomb_friction_and_cubic_stiffness_are_named_together(tmp_path, fmu_dir, measured):
@@ -127,16 +128,16 @@ def test_sdof_coulomb_friction_and_cubic_stiffness_are_named_together(tmp_path, 
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "coulomb_friction+cubic_stiffness", periods=2,
                                   truth=truth)
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert set(rep["chosen_effect"].split(" + ")) == {"coulomb_friction", "cubic_stiffness"}, rep["verdict"]
-    best = rep["ranking"][0]
+    assert set(rep.chosen) == {"coulomb_friction", "cubic_stiffness"}, rep.sentence
+    best = rep.ranking[0]
     measured("SDOF with Coulomb friction and cubic stiffness withheld: held-out shrink of the pair [%]",
-             best["shrink_pct"], 90.0, at_least=True)
-    measured("the same: fitted k3 relative to the withheld value", abs(best["params"]["k3"] / truth["k3"] - 1), 0.05)
+             best.shrink_pct, 90.0, at_least=True)
+    measured("the same: fitted k3 relative to the withheld value", abs(best.params["k3"] / truth["k3"] - 1), 0.05)
     # a combination is refitted from the model it extends and never ends worse than it on the calibration files
-    calibration = {r["effect"]: r["calibration_nrmse"] for r in rep["ranking"]}
-    for r in rep["ranking"]:
-        if len(r["members"]) > 1:
-            assert r["calibration_nrmse"] <= max(calibration[m] for m in r["members"]) * (1 + 1e-12), r["effect"]
+    calibration = {r.effect: r.calibration_nrmse for r in rep.ranking}
+    for r in rep.ranking:
+        if len(r.members) > 1:
+            assert r.calibration_nrmse <= max(calibration[m] for m in r.members) * (1 + 1e-12), r.effect
 
 
 def test_a_weak_loop_beside_a_strong_cubic_spring_is_named_as_both(tmp_path, fmu_dir, measured):
@@ -154,11 +155,11 @@ def test_a_weak_loop_beside_a_strong_cubic_spring_is_named_as_both(tmp_path, fmu
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "cubic_stiffness+hysteresis", seed=56,
                                   truth=truth, style=datasets.LabStyle("noise", ("y",), record_s=8.0))
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert set((rep["chosen_effect"] or "").split(" + ")) == {"cubic_stiffness", "hysteresis"}, \
-        (truth, rep["verdict"], [(r["effect"], r["heldout_gap_after"]) for r in rep["ranking"][:4]])
-    best = rep["ranking"][0]
+    assert set(rep.chosen) == {"cubic_stiffness", "hysteresis"}, \
+        (truth, rep.sentence, [(r.effect, r.heldout_gap_after) for r in rep.ranking[:4]])
+    best = rep.ranking[0]
     measured("SDOF with a weak loop beside a strong cubic spring: fitted k3 relative to the withheld value",
-             abs(best["params"]["k3"] / truth["k3"] - 1), 0.1)
+             abs(best.params["k3"] / truth["k3"] - 1), 0.1)
 
 
 def _campaign_case_named(tmp_path, fmu_dir, seed: int, index: int, withheld: str, excitation: str,
@@ -176,7 +177,7 @@ def _campaign_case_named(tmp_path, fmu_dir, seed: int, index: int, withheld: str
     assert outcome["named"] == withheld, outcome["verdict"]
     case = dataclasses.replace(case, truth=outcome["case"]["truth"])
     report = tmp_path / f"case{index:04d}" / "diagnosis" / "report.json"
-    return case, json.loads(report.read_text())["ranking"][0]
+    return case, Diagnosis.read(report).ranking[0]
 
 
 def test_a_pair_whose_least_helpful_partner_stands_in_for_its_second_member_is_named(tmp_path, fmu_dir, measured):
@@ -186,7 +187,7 @@ def test_a_pair_whose_least_helpful_partner_stands_in_for_its_second_member_is_n
     zero it is the friction alone again, so the pair is named and k3 recovered."""
     case, best = _campaign_case_named(tmp_path, fmu_dir, 15, 118, "coulomb_friction+cubic_stiffness", "multisine")
     measured("SDOF with Coulomb friction and a hardening spring, a loop standing in as well: fitted k3 relative to "
-             "the withheld value", abs(best["params"]["k3"] / case.truth["k3"] - 1), 0.1)
+             "the withheld value", abs(best.params["k3"] / case.truth["k3"] - 1), 0.1)
 
 
 def test_a_one_parameter_partner_that_a_loop_outdoes_beside_the_first_member_is_named(tmp_path, fmu_dir, measured):
@@ -196,7 +197,7 @@ def test_a_one_parameter_partner_that_a_loop_outdoes_beside_the_first_member_is_
     pair; c2 is recovered."""
     case, best = _campaign_case_named(tmp_path, fmu_dir, 16, 194, "coulomb_friction+quadratic_damping", "noise")
     measured("SDOF with Coulomb friction and quadratic damping under noise, a loop absorbing more beside the "
-             "friction: fitted c2 relative to the withheld value", abs(best["params"]["c2"] / case.truth["c2"] - 1),
+             "friction: fitted c2 relative to the withheld value", abs(best.params["c2"] / case.truth["c2"] - 1),
              0.05)
 
 
@@ -209,7 +210,7 @@ def test_a_lean_pair_whose_descent_stalls_is_not_lost_to_a_loop_pair(tmp_path, f
     # measured 0.09 (its refit on stops there too, above the truth's held-out misfit): room for 1.5x that
     measured("SDOF with Coulomb friction and quadratic damping on sweeps, a loop pair fitting better before the "
              "pair's refit on: fitted c2 relative to the withheld value",
-             abs(best["params"]["c2"] / case.truth["c2"] - 1), 0.15)
+             abs(best.params["c2"] / case.truth["c2"] - 1), 0.15)
 
 
 def test_a_loop_standing_in_for_a_spring_beyond_its_own_sensitivity_leaves_the_spring_path_its_try(
@@ -225,7 +226,7 @@ def test_a_loop_standing_in_for_a_spring_beyond_its_own_sensitivity_leaves_the_s
     outcome = json.loads((tmp_path / "case0183" / "outcome.json").read_text())
     assert outcome["named_held_out"] <= outcome["truth_held_out"]
     measured("SDOF with a hardening spring and a loop that stands in for it alone: fitted k3 relative to the "
-             "withheld value", abs(best["params"]["k3"] / case.truth["k3"] - 1), 0.1)
+             "withheld value", abs(best.params["k3"] / case.truth["k3"] - 1), 0.1)
 
 
 def test_a_damper_loop_standing_in_for_hardening_springs_leaves_the_springs_path_its_try(
@@ -237,7 +238,7 @@ def test_a_damper_loop_standing_in_for_hardening_springs_leaves_the_springs_path
     the loop beside them, and the pair is named with the springs' stiffness recovered."""
     case, best = _campaign_case_named(tmp_path, fmu_dir, 0, 2, "cubic_stiffness+hysteresis", "multisine", "damper")
     measured("damper with hardening springs and a loop standing in for them: fitted k_cs2 relative to the withheld "
-             "value", abs(best["params"]["k_cs2"] / case.truth["k_cs2"] - 1), 0.1)
+             "value", abs(best.params["k_cs2"] / case.truth["k_cs2"] - 1), 0.1)
 
 
 def test_a_pair_whose_joint_refit_failed_on_the_loop_path_is_refitted_again_on_the_springs_path(
@@ -249,7 +250,7 @@ def test_a_pair_whose_joint_refit_failed_on_the_loop_path_is_refitted_again_on_t
     case, best = _campaign_case_named(tmp_path, fmu_dir, 1, 99, "cubic_stiffness+hysteresis", "multisine", "damper")
     # measured 0.003: the springs set the resonance shift the records resolve well above the noise
     measured("damper with hardening springs and a loop whose pair refit on the loop's path added nothing: fitted "
-             "k_cs2 relative to the withheld value", abs(best["params"]["k_cs2"] / case.truth["k_cs2"] - 1), 0.03)
+             "k_cs2 relative to the withheld value", abs(best.params["k_cs2"] / case.truth["k_cs2"] - 1), 0.03)
 
 
 def test_a_loop_beside_a_held_quadratic_damping_is_refitted_from_each_of_its_basins(tmp_path, fmu_dir, measured):
@@ -258,7 +259,7 @@ def test_a_loop_beside_a_held_quadratic_damping_is_refitted_from_each_of_its_bas
     start of each of its basins, as its own refit does, and finds the pair's; c2 is recovered."""
     case, best = _campaign_case_named(tmp_path, fmu_dir, 18, 153, "hysteresis+quadratic_damping", "stepped_sine")
     measured("SDOF with a loop and a strong quadratic damping on stepped sines: fitted c2 relative to the withheld "
-             "value", abs(best["params"]["c2"] / case.truth["c2"] - 1), 0.05)
+             "value", abs(best.params["c2"] / case.truth["c2"] - 1), 0.05)
 
 
 def test_a_weak_quadratic_damping_beside_a_strong_cubic_spring_is_named(tmp_path, fmu_dir, measured):
@@ -269,9 +270,9 @@ def test_a_weak_quadratic_damping_beside_a_strong_cubic_spring_is_named(tmp_path
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "cubic_stiffness+quadratic_damping", seed=40,
                                   periods=2, truth=truth, style=datasets.LabStyle("sweep", ("a",), record_s=6.0))
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert set((rep["chosen_effect"] or "").split(" + ")) == {"cubic_stiffness", "quadratic_damping"}, rep["verdict"]
+    assert set(rep.chosen) == {"cubic_stiffness", "quadratic_damping"}, rep.sentence
     measured("SDOF with a strong cubic spring and a weak quadratic damping on sweeps: fitted c2 relative to the "
-             "withheld value", abs(rep["ranking"][0]["params"]["c2"] / truth["c2"] - 1), 0.1)
+             "withheld value", abs(rep.ranking[0].params["c2"] / truth["c2"] - 1), 0.1)
 
 
 def test_the_thesis_damper_with_hysteresis_and_softening_springs_is_named_as_both(tmp_path, fmu_dir, measured):
@@ -291,10 +292,10 @@ def test_the_thesis_damper_with_hysteresis_and_softening_springs_is_named_as_bot
     data = datasets.write_dataset(tmp_path / "data", datasets.DAMPER, "hysteresis+cubic_stiffness",
                                   style=datasets.LabStyle("sweep", motion="x"), truth=truth, base=messenger)
     rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert set((rep["chosen_effect"] or "").split(" + ")) == {"hysteresis", "cubic_stiffness"}, rep["verdict"]
+    assert set(rep.chosen) == {"hysteresis", "cubic_stiffness"}, rep.sentence
     measured("the thesis's damper (hysteresis + softening cubic springs, random loop shape): held-out shrink [%]",
-             rep["ranking"][0]["shrink_pct"], 80.0, at_least=True)
-    assert json.loads((tmp_path / "out" / "report.json").read_text())["verdict"].startswith("gap explained by")
+             rep.ranking[0].shrink_pct, 80.0, at_least=True)
+    assert Diagnosis.read(tmp_path / "out" / "report.json").verdict is Verdict.EXPLAINED
 
 
 def test_a_weak_sharp_loop_softening_on_both_branches_is_named(tmp_path, fmu_dir, measured):
@@ -304,7 +305,7 @@ def test_a_weak_sharp_loop_softening_on_both_branches_is_named(tmp_path, fmu_dir
     and α recovered."""
     case, best = _campaign_case_named(tmp_path, fmu_dir, 17, 132, "hysteresis", "sweep")
     measured("SDOF with a weak, sharp loop softening on both branches under sweeps: fitted alpha relative to the "
-             "withheld value", abs(best["params"]["alpha"] / case.truth["alpha"] - 1), 0.01)
+             "withheld value", abs(best.params["alpha"] / case.truth["alpha"] - 1), 0.01)
 
 
 def test_a_very_weak_loop_is_named(tmp_path, fmu_dir, measured):
@@ -320,7 +321,7 @@ def test_a_very_weak_loop_is_named(tmp_path, fmu_dir, measured):
     measured("SDOF with a very weak loop under sweeps: held-out NRMSE of the named model over the truth's",
              outcome["named_held_out"] / outcome["truth_held_out"], 1.05)  # measured 0.94
     measured("SDOF with a very weak loop under sweeps: fitted alpha relative to the withheld value",
-             abs(best["params"]["alpha"] / case.truth["alpha"] - 1), 0.5)
+             abs(best.params["alpha"] / case.truth["alpha"] - 1), 0.5)
 
 
 def test_a_strong_loop_is_named_alone_not_beside_a_stand_in_spring(tmp_path, fmu_dir, measured):
@@ -332,13 +333,13 @@ def test_a_strong_loop_is_named_alone_not_beside_a_stand_in_spring(tmp_path, fmu
     loop alone is named, at the noise, with α recovered."""
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "hysteresis")
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert rep["chosen_effect"] == "hysteresis"
-    best = rep["ranking"][0]
+    assert rep.chosen_name == "hysteresis"
+    best = rep.ranking[0]
     truth = json.loads((data / "truth.json").read_text())["params"]
     measured("SDOF benchmark loop (default dataset): held-out NRMSE of the loop alone over the noise floor",
-             best["heldout_gap_after"] / rep["gap"]["noise_floor"], 1.05)  # measured 0.99
+             best.heldout_gap_after / rep.gap.noise_floor, 1.05)  # measured 0.99
     measured("SDOF benchmark loop (default dataset): fitted alpha relative to the withheld value",
-             abs(best["params"]["alpha"] / truth["alpha"] - 1), 0.05)  # measured 0.009
+             abs(best.params["alpha"] / truth["alpha"] - 1), 0.05)  # measured 0.009
 
 
 def test_a_spring_a_free_shape_loop_matches_within_the_noise_is_named_as_the_spring(tmp_path, fmu_dir, measured):
@@ -347,15 +348,15 @@ def test_a_spring_a_free_shape_loop_matches_within_the_noise_is_named_as_the_spr
     of each other (the loop stiffening as the spring does). No partner is tried; of the single effects the one
     with fewer parameters is named (selection.simpler_or_better, as between path ends), and k3 recovered."""
     case, best = _campaign_case_named(tmp_path, fmu_dir, 19, 24, "cubic_stiffness", "multisine", sized=True)
-    rep = json.loads((tmp_path / "case0024" / "diagnosis" / "report.json").read_text())
-    after = {d["effect"]: d["heldout_gap_after"] for d in rep["ranking"]}
+    rep = Diagnosis.read(tmp_path / "case0024" / "diagnosis" / "report.json")
+    after = {d.effect: d.heldout_gap_after for d in rep.ranking}
     assert after["hysteresis"] <= (1.0 + selection.ALIKE) * after["cubic_stiffness"]  # the data do not tell them
     md = (tmp_path / "case0024" / "diagnosis" / "report.md").read_text()
     # the report says why the spring is named when the loop's misfit is the lower one (measured: 0.05 % lower)
     why = "cubic_stiffness, with fewer parameters, is named"
     assert (why in md) == (after["hysteresis"] < after["cubic_stiffness"])
     measured("SDOF spring a loop matches within the noise: fitted k3 relative to the withheld value",
-             abs(best["params"]["k3"] / case.truth["k3"] - 1), 0.1)  # measured 0.077
+             abs(best.params["k3"] / case.truth["k3"] - 1), 0.1)  # measured 0.077
 
 
 
@@ -366,15 +367,15 @@ def test_a_pair_whose_stronger_member_alone_lands_just_above_the_noise_is_extend
     (extend_factor x it), so the spring is tried beside it; the pair is named and both strengths recovered."""
     case, best = _campaign_case_named(tmp_path, fmu_dir, 18, 76, "cubic_stiffness+quadratic_damping",
                                       "stepped_sine", sized=True)
-    rep = json.loads((tmp_path / "case0076" / "diagnosis" / "report.json").read_text())
-    single = next(d["heldout_gap_after"] for d in rep["ranking"] if d["effect"] == "quadratic_damping")
-    cfg, above = dg.DiagnoseConfig(), rep["gap"]["noise_floor_scaled"]
+    rep = Diagnosis.read(tmp_path / "case0076" / "diagnosis" / "report.json")
+    single = next(d.heldout_gap_after for d in rep.ranking if d.effect == "quadratic_damping")
+    cfg, above = dg.DiagnoseConfig(), rep.gap.noise_floor_scaled
     assert selection.significant(single, above, cfg.extend_factor, cfg.combination_min_gap)
     assert not selection.significant(single, above, cfg.noise_factor, cfg.combination_min_gap)
     measured("SDOF pair whose damping alone lands just above the noise: fitted k3 relative to the withheld value",
-             abs(best["params"]["k3"] / case.truth["k3"] - 1), 0.05)  # measured 0.014
+             abs(best.params["k3"] / case.truth["k3"] - 1), 0.05)  # measured 0.014
     measured("SDOF pair whose damping alone lands just above the noise: fitted c2 relative to the withheld value",
-             abs(best["params"]["c2"] / case.truth["c2"] - 1), 0.05)  # measured 0.0075
+             abs(best.params["c2"] / case.truth["c2"] - 1), 0.05)  # measured 0.0075
 
 def test_an_effect_under_the_noise_threshold_is_told_from_noise_by_its_refit(tmp_path, fmu_dir, measured):
     """A weak quadratic damping under a sweep recorded as displacement (a case of the check campaign's draw,
@@ -382,13 +383,13 @@ def test_an_effect_under_the_noise_threshold_is_told_from_noise_by_its_refit(tmp
     refit (refit_within_noise, the default) removes part of it on the held-out files, where a refit
     of noise alone carries nothing over; the damping is named and c2 recovered."""
     case, best = _campaign_case_named(tmp_path, fmu_dir, 19, 18, "quadratic_damping", "sweep")
-    gap = json.loads((tmp_path / "case0018" / "diagnosis" / "report.json").read_text())["gap"]
-    assert gap["overall"] <= selection.noise_level(gap["noise_floor"], dg.DiagnoseConfig().noise_factor,
+    gap = Diagnosis.read(tmp_path / "case0018" / "diagnosis" / "report.json").gap
+    assert gap.overall <= selection.noise_level(gap.noise_floor, dg.DiagnoseConfig().noise_factor,
                                                    dg.DiagnoseConfig().min_gap)  # under the nominal's own test
     measured("SDOF with a quadratic damping under the noise threshold: share of the nominal's held-out misfit its "
-             "refit removes", gap["detection"]["cut"], dg.DiagnoseConfig().min_detect_cut, at_least=True)
+             "refit removes", gap.detection.cut, dg.DiagnoseConfig().min_detect_cut, at_least=True)
     measured("SDOF with a quadratic damping under the noise threshold: fitted c2 relative to the withheld value",
-             abs(best["params"]["c2"] / case.truth["c2"] - 1), 0.05)
+             abs(best.params["c2"] / case.truth["c2"] - 1), 0.05)
 
 
 def test_noise_alone_refitted_below_the_noise_threshold_is_no_gap(tmp_path, fmu_dir, measured):
@@ -397,10 +398,10 @@ def test_noise_alone_refitted_below_the_noise_threshold_is_no_gap(tmp_path, fmu_
     less of the held-out misfit than min_detect_cut (what a refit fits of the calibration files' noise does not
     carry over to the held-out files): no gap."""
     _campaign_case_named(tmp_path, fmu_dir, 19, 4, "none", "stepped_sine")
-    gap = json.loads((tmp_path / "case0004" / "diagnosis" / "report.json").read_text())["gap"]
-    assert not gap["detection"]["detected"]
+    gap = Diagnosis.read(tmp_path / "case0004" / "diagnosis" / "report.json").gap
+    assert not gap.detection.detected
     measured("SDOF null case refitted below the noise threshold: share of the held-out misfit the best refit "
-             "removes", gap["detection"]["cut"], dg.DiagnoseConfig().min_detect_cut)
+             "removes", gap.detection.cut, dg.DiagnoseConfig().min_detect_cut)
 
 
 @pytest.mark.parametrize("drawn", [True, False], ids=["random loop and springs", "the design damper's"])
@@ -421,12 +422,12 @@ def test_a_damper_pair_on_stepped_sines_through_a_hardening_jump_is_named_as_bot
     data = datasets.write_dataset(tmp_path / "data", datasets.DAMPER, "hysteresis+cubic_stiffness",
                                   style=datasets.LabStyle("stepped_sine", ("x1", "x2"), "x"), truth=truth)
     rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert set((rep["chosen_effect"] or "").split(" + ")) == {"hysteresis", "cubic_stiffness"}, rep["verdict"]
-    best = rep["ranking"][0]
+    assert set(rep.chosen) == {"hysteresis", "cubic_stiffness"}, rep.sentence
+    best = rep.ranking[0]
     truth = json.loads((data / "truth.json").read_text())["params"]
     for name in ("k_cs1", "k_cs2"):
         measured(f"stepped sines through a jump ({'drawn' if drawn else 'design'}): {name}'s relative error",
-                 abs(best["params"][name] / truth[name] - 1), 0.03)
-    if best["heldout_gap_after"] > rep["explained_below"]:  # the fit follows the other steady state somewhere
-        assert best["explains_in_band"] and best["prediction_band"]["heldout_nrmse"] <= rep["explained_below"]
-        assert rep["confined_misfit"]["nrmse_rest"] <= rep["explained_below"]
+                 abs(best.params[name] / truth[name] - 1), 0.03)
+    if best.heldout_gap_after > rep.explained_below:  # the fit follows the other steady state somewhere
+        assert best.explains_in_band and best.prediction_band["heldout_nrmse"] <= rep.explained_below
+        assert rep.confined_misfit["nrmse_rest"] <= rep.explained_below

@@ -7,6 +7,7 @@ import pathlib
 import pytest
 
 from pyfit.gap import datasets
+from pyfit.gap.result import Verdict
 from pyfit.gap import diagnose as dg
 from pyfit.io.nominal import load_nominal
 
@@ -18,10 +19,10 @@ SYMMETRIC = load_nominal(ROOT / "configs" / "symmetric_damper.toml")
 
 def _check(rep, effect, measured, what):
     if effect == "none":
-        assert rep["verdict"] == "no significant gap", rep["verdict"]
+        assert rep.verdict is Verdict.NO_GAP, rep.sentence
         return
-    assert rep["chosen_effect"] == effect, (rep["verdict"], [(r["effect"], r["shrink_pct"]) for r in rep["ranking"]])
-    measured(f"{what}, {effect} withheld: held-out shrink of the chosen effect [%]", rep["ranking"][0]["shrink_pct"],
+    assert rep.chosen_name == effect, (rep.sentence, [(r.effect, r.shrink_pct) for r in rep.ranking])
+    measured(f"{what}, {effect} withheld: held-out shrink of the chosen effect [%]", rep.ranking[0].shrink_pct,
              80.0, at_least=True)
 
 
@@ -37,7 +38,7 @@ def test_sdof_force_sweeps_with_an_accelerometer(tmp_path, fmu_dir, effect, meas
     # second-best single, far from the noise, is extended on its own path (DiagnoseConfig.beam)
     if effect != "none":
         beside = sorted(p.name for p in (tmp_path / "out" / "fits").glob(f"*.beside.{effect}.json"))
-        assert not beside, (beside, [r["effect"] for r in rep["ranking"]])
+        assert not beside, (beside, [r.effect for r in rep.ranking])
 
 
 @pytest.mark.slow
@@ -112,10 +113,10 @@ def test_design_damper_from_another_benchs_export_with_load_cell_and_acceleromet
                                   style=datasets.LabStyle("sweep", outputs=("F_clamp", "acc_x1"), motion="x"))
     data = _foreign_export(ours, tmp_path / "export")
     rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert rep["level_order"] == "excitation.amplitude"
+    assert rep.level_order == "excitation.amplitude"
     _check(rep, "coulomb_friction", measured, "design damper, another bench's export (load cell, accelerometer, "
                                               "clamp displacement only)")
     truth = json.loads((ours / "truth.json").read_text())["params"]
     for name in ("F_c1", "F_c2"):
         measured(f"the same: fitted {name} relative to the withheld value",
-                 abs(rep["ranking"][0]["params"][name] / truth[name] - 1), 0.05)
+                 abs(rep.ranking[0].params[name] / truth[name] - 1), 0.05)

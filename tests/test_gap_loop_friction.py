@@ -11,6 +11,7 @@ import scipy.stats
 
 from gap_cases import CI, case, diagnosed, found_where_it_acts, strength_recovered
 from pyfit.gap import attribute
+from pyfit.gap.result import Diagnosis
 from pyfit.gap import diagnose as dg
 
 
@@ -34,16 +35,16 @@ def test_a_parameter_set_s_misfit_on_the_diagnosis_split(data_root, fmu_dir, mea
     calibrated others kept) it stays within the noise floor's reach on both the held-out and the calibration
     files (each against the floor of its own files: a lower level's is higher), far below the nominal's gap."""
     out = diagnosed(data_root, fmu_dir, "coulomb_friction")
-    rep = json.loads((out / "report.json").read_text())
+    rep = Diagnosis.read(out / "report.json")
     data = case(data_root, "coulomb_friction")
-    at_nominal = dg.misfit_at("sdof", data, rep["nominal"]["params"], CI, fmu_dir)
-    assert at_nominal.held_out == pytest.approx(rep["gap"]["overall"], rel=1e-9)
+    at_nominal = dg.misfit_at("sdof", data, rep.nominal.params, CI, fmu_dir)
+    assert at_nominal.held_out == pytest.approx(rep.gap.overall, rel=1e-9)
     truth = json.loads((data / "truth.json").read_text())["params"]
-    at_truth = dg.misfit_at("sdof", data, {**rep["nominal"]["params"], **truth}, CI, fmu_dir)
-    floor = rep["gap"]["noise_floor"]
+    at_truth = dg.misfit_at("sdof", data, {**rep.nominal.params, **truth}, CI, fmu_dir)
+    floor = rep.gap.noise_floor
     measured("truth's held-out NRMSE over the noise floor (withheld friction, FMU at the CasADi truth)",
              at_truth.held_out / floor, 1.5)
-    cal_floor = np.sqrt(np.mean([d["noise_floor"] ** 2 for d in rep["gap"]["by_level"] if not d["held_out"]]))
+    cal_floor = np.sqrt(np.mean([d.noise_floor ** 2 for d in rep.gap.by_level if not d.held_out]))
     assert at_truth.calibration < 1.5 * cal_floor and at_nominal.held_out > 5 * at_truth.held_out
 
 

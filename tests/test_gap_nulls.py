@@ -3,7 +3,6 @@ under -m slow), a skew between the channels named sensor_delay, clear errors on 
 the model's opposite sign convention among them), the linear start from the measured FRF of accelerometer records
 under band-limited noise (three more noise seeds under -m slow)."""
 import dataclasses
-import json
 import re
 import shutil
 
@@ -12,6 +11,7 @@ import pytest
 
 from gap_cases import CI, case
 from pyfit.gap import campaign, datasets
+from pyfit.gap.result import Diagnosis, Verdict
 from pyfit.gap import diagnose as dg
 from pyfit.gap import simulate as sim
 from pyfit.gap.polarity import with_signs_changed
@@ -31,11 +31,11 @@ def test_null_dataset_gives_no_false_alarm(data_root, fmu_dir, seed, measured):
     cfg = dataclasses.replace(CI, refit_within_noise=seed > 0)
     rep = dg.diagnose("sdof", case(data_root, "none", seed), data_root / f"out_none{seed}", cfg, fmu_dir,
                       workers=2, progress=False)
-    assert rep["verdict"] == "no significant gap" and rep["chosen_effect"] is None
-    assert rep["gap"]["detection"]["cut"] < cfg.min_detect_cut if seed else not rep["ranking"]
+    assert rep.verdict is Verdict.NO_GAP and rep.chosen_name is None
+    assert rep.gap.detection.cut < cfg.min_detect_cut if seed else not rep.ranking
     # the nominal fit sits on the noise floor the data give (5e-6 m noise, about 0.4 % of the output RMS)
     measured(f"SDOF gap diagnosis, null dataset seed {seed} ('no significant gap'): |held-out gap / noise floor − 1|",
-             abs(rep["gap"]["overall"] / rep["gap"]["noise_floor"] - 1), 0.1)
+             abs(rep.gap.overall / rep.gap.noise_floor - 1), 0.1)
 
 
 def test_bad_input_gives_one_clear_error(data_root, tmp_path, fmu_dir):
@@ -107,9 +107,9 @@ def test_a_skew_between_the_channels_is_named_sensor_delay(data_root, fmu_dir, m
     """The input channel 1.3 ms ahead of the output (unsynchronised DAQ modules): named, and the delay found."""
     rep = dg.diagnose("sdof", case(data_root, "sensor_delay"), data_root / "out_sensor_delay", CI, fmu_dir,
                       workers=2, progress=False)
-    assert rep["chosen_effect"] == "sensor_delay", rep["ranking"][:2]
+    assert rep.chosen_name == "sensor_delay", rep.ranking[:2]
     measured("SDOF gap diagnosis, a 1.3 ms skew between input and output channels: |fitted delay − 1.3 ms| [ms]",
-             abs(rep["ranking"][0]["params"]["sensor_delay"] - 1.3e-3) * 1e3, 0.02)
+             abs(rep.ranking[0].params["sensor_delay"] - 1.3e-3) * 1e3, 0.02)
 
 
 # the noise seed on which the start's resonance once fell to 3 Hz; three drawn at random under -m slow
@@ -144,11 +144,11 @@ def test_a_linear_candidate_tells_no_gap_below_the_noise_threshold(tmp_path, fmu
     cfg = dg.DiagnoseConfig()
     outcome = campaign.run_case(campaign.CaseJob(null, str(tmp_path), str(fmu_dir), campaign.RECORD_S, cfg))
     assert outcome["named"] == "none" and outcome["verdict"] == "no significant gap", outcome["verdict"]
-    rep = json.loads((tmp_path / "case0013" / "diagnosis" / "report.json").read_text())
-    after = {r["effect"]: r["heldout_gap_after"] for r in rep["ranking"]}
+    rep = Diagnosis.read(tmp_path / "case0013" / "diagnosis" / "report.json")
+    after = {r.effect: r.heldout_gap_after for r in rep.ranking}
     measured("damper null case: held-out misfit the mass eccentricity's refit removes (a share; counted it would "
-             "tell a gap)", 1 - after["mass_eccentricity"] / rep["gap"]["overall"], cfg.min_detect_cut,
+             "tell a gap)", 1 - after["mass_eccentricity"] / rep.gap.overall, cfg.min_detect_cut,
              at_least=True)
-    assert rep["gap"]["detection"]["effect"] != "mass_eccentricity"
+    assert rep.gap.detection.effect != "mass_eccentricity"
     measured("damper null case: held-out misfit the best nonlinear refit removes beyond its linear part (a share)",
-             rep["gap"]["detection"]["cut"], cfg.min_detect_cut)
+             rep.gap.detection.cut, cfg.min_detect_cut)

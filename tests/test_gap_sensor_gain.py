@@ -62,7 +62,7 @@ def test_a_gain_between_the_channels_is_named_sensor_gain(tmp_path, fmu_dir, mea
     default = dg.DiagnoseConfig()
     cfg = dataclasses.replace(default, effects=dg.tried_effects(system, default) + ["sensor_gain"])
     rep = dg.diagnose("damper", data, tmp_path / "out", cfg, fmu_dir, workers=2, progress=False)
-    assert rep["chosen_effect"] == "sensor_gain", (rep["verdict"], rep["ranking"][:2])
-    fitted = next(r["params"]["sensor_gain"] for r in rep["ranking"] if r["effect"] == "sensor_gain")
+    assert rep.chosen_name == "sensor_gain", (rep.sentence, rep.ranking[:2])
+    fitted = next(r.params["sensor_gain"] for r in rep.ranking if r.effect == "sensor_gain")
     measured(f"damper null case, accelerometers reading {100 * g:+.2f} % off: |fitted sensor_gain − gain|",
              abs(fitted - g), 0.003)

@@ -80,9 +80,9 @@ def test_a_stepped_sine_recorded_a_file_per_frequency_is_diagnosed(tmp_path, fmu
                               {"F": (noisy["u"], "N", "u")}, {"y": (noisy["y"], "m", "y")}, level=f"{level:g} N",
                               level_value=level, excitation={"kind": "sine", "frequency_hz": float(f)})
     rep = dg.diagnose("sdof", tmp_path / "data", tmp_path / "out", fmu_dir=fmu_dir, workers=2)
-    assert rep["calibration_files"] == sorted(p.stem for p in (tmp_path / "data").glob("L15N_*.csv"))
-    assert rep["verdict"] == "gap explained by cubic_stiffness", rep["verdict"]
-    fitted = next(r for r in rep["ranking"] if r["effect"] == "cubic_stiffness")["params"]["k3"]
+    assert list(rep.calibration_files) == sorted(p.stem for p in (tmp_path / "data").glob("L15N_*.csv"))
+    assert rep.chosen == ("cubic_stiffness",), rep.sentence
+    fitted = next(r for r in rep.ranking if r.effect == "cubic_stiffness").params["k3"]
     measured("stepped sine in a file per frequency (SDOF, cubic spring drawn over a decade): fitted k3 vs the "
              "truth, relative", abs(fitted / k3 - 1), 0.03)
 
@@ -114,8 +114,8 @@ def test_one_continuous_record_of_three_levels_cut_by_segments_is_diagnosed(tmp_
         f"[[segments]]\nfrom_s = {k * stage}\nto_s = {(k + 1) * stage}\nlevel = \"{a:g} N\"\nlevel_value = {a}\n"
         for k, a in enumerate((10.0, 25.0, 50.0))))
     rep = dg.diagnose("sdof", tmp_path / "data", tmp_path / "out", fmu_dir=fmu_dir, workers=2, progress=False)
-    assert (rep["calibration_files"], rep["held_out_files"]) == (["run#1", "run#3"], ["run#2"])
-    assert rep["verdict"] == "gap explained by cubic_stiffness", rep["verdict"]
-    fitted = next(r for r in rep["ranking"] if r["effect"] == "cubic_stiffness")["params"]["k3"]
+    assert (rep.calibration_files, rep.held_out_files) == (("run#1", "run#3"), ("run#2",))
+    assert rep.chosen == ("cubic_stiffness",), rep.sentence
+    fitted = next(r for r in rep.ranking if r.effect == "cubic_stiffness").params["k3"]
     measured("one record of three levels cut by [[segments]] (SDOF, cubic spring drawn over a decade): fitted k3 vs "
              "the truth, relative", abs(fitted / k3 - 1), 0.03)

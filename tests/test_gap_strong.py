@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from pyfit.gap import datasets
+from pyfit.gap.result import Verdict
 from pyfit.gap import diagnose as dg
-from pyfit.gap.report import best_calibration_nrmse
+from pyfit.gap.judge import best_calibration_nrmse
 
 pytestmark = pytest.mark.slow
 
@@ -27,13 +28,13 @@ def test_a_nominal_that_fits_no_calibration_file_still_has_its_effects_refitted(
                                   truth=truth, style=datasets.LabStyle("stepped_sine", ("a",), record_s=6.0))
     cfg = dg.DiagnoseConfig(nominal_max_nrmse=0.02)
     rep = dg.diagnose("sdof", data, tmp_path / "out", cfg, fmu_dir, workers=2, progress=False)
-    assert best_calibration_nrmse(rep["gap"])[0] > cfg.nominal_max_nrmse
-    assert rep["verdict"] != "nominal model does not fit", rep["evidence"]
-    assert "the response changes strongly with amplitude" in rep["evidence"][0]
-    best = rep["ranking"][0]
-    assert best["effect"] == "cubic_stiffness", (truth, rep["verdict"], [r["effect"] for r in rep["ranking"][:3]])
+    assert best_calibration_nrmse(rep.gap)[0] > cfg.nominal_max_nrmse
+    assert rep.verdict is not Verdict.NOMINAL_MISFITS, rep.evidence
+    assert "the response changes strongly with amplitude" in rep.evidence[0]
+    best = rep.ranking[0]
+    assert best.effect == "cubic_stiffness", (truth, rep.sentence, [r.effect for r in rep.ranking[:3]])
     measured("SDOF hardening spring on stepped sines, a nominal that fits no calibration file: held-out shrink of "
-             "the cubic spring [%]", best["shrink_pct"], 90.0, at_least=True)
+             "the cubic spring [%]", best.shrink_pct, 90.0, at_least=True)
 
 
 def test_records_whose_output_is_unrelated_to_the_input_do_not_fit(tmp_path, fmu_dir):
@@ -49,6 +50,6 @@ def test_records_whose_output_is_unrelated_to_the_input_do_not_fit(tmp_path, fmu
         table[:, output] = table[::-1, output]
         np.savetxt(csv, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
-    assert rep["verdict"] == "nominal model does not fit", (rep["verdict"], rep["evidence"][:1])
-    assert rep["ranking"], "the effects were refitted before the verdict"
-    assert min(r["calibration_nrmse"] for r in rep["ranking"]) > dg.DiagnoseConfig().nominal_max_nrmse
+    assert rep.verdict is Verdict.NOMINAL_MISFITS, (rep.sentence, rep.evidence[:1])
+    assert rep.ranking, "the effects were refitted before the verdict"
+    assert min(r.calibration_nrmse for r in rep.ranking) > dg.DiagnoseConfig().nominal_max_nrmse

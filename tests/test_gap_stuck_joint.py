@@ -52,8 +52,8 @@ def test_a_damper_joint_stuck_at_the_lowest_level_is_named_and_its_friction_reco
     described = NominalModel("damper", {k: v for k, v in base.items() if k not in ("EI", "alpha_pd", "beta_pd")})
     rep = dg.diagnose("damper", data, tmp_path / "out", dg.DiagnoseConfig(effects=EFFECTS), fmu_dir, workers=2,
                       progress=False, nominal=described)
-    assert rep["chosen_effect"] == "coulomb_friction", (rep["verdict"], style, truth,
-                                                        [(r["effect"], r["shrink_pct"]) for r in rep["ranking"]])
+    assert rep.chosen_name == "coulomb_friction", (rep.sentence, style, truth,
+                                                        [(r.effect, r.shrink_pct) for r in rep.ranking])
     fit = json.loads((tmp_path / "out" / "fits" / "coulomb_friction.json").read_text())["fit"]["params"]
     error = max(abs(fit[k] / truth[k] - 1.0) for k in ("F_c1", "F_c2"))
     measured(f"stuck damper joint (seed {seed}, {'+'.join(style.outputs)}, clamp {style.motion}): friction "

@@ -1,7 +1,6 @@
 """The gap diagnosis on a damper characteristic test (IEC 61897: clamp impedance at three clamp-velocity
 levels) made by the independent CasADi reference damper with measurement noise (0.5 % in |Z|, 0.3° in
 phase; the sidecar states 1 %), through `python scripts/diagnose.py --impedance`."""
-import json
 import subprocess
 import sys
 import pathlib
@@ -10,6 +9,7 @@ import numpy as np
 import pytest
 
 from pyfit.gap.datasets import DAMPER, IMPEDANCE_UNCERTAINTY, write_impedance_case
+from pyfit.gap.result import Diagnosis, Verdict
 from pyfit.gap.diagnose import DiagnoseConfig, DiagnoseError
 from pyfit.gap import impedance_gap
 from pyfit.gap.impedance_gap import diagnose_impedance
@@ -25,7 +25,7 @@ def _diagnose_cli(test: pathlib.Path, out: pathlib.Path, fmu_dir, *extra) -> sub
                           timeout=1200)
 
 
-def _rerun_from_stored_fits(monkeypatch, *args, **kwargs) -> dict:
+def _rerun_from_stored_fits(monkeypatch, *args, **kwargs) -> Diagnosis:
     """The diagnosis again into the same folder with every fit forbidden: it must come from OUT/fits/."""
     def no_fit(*_):
         raise AssertionError("a fit was redone although it was stored")
@@ -50,13 +50,13 @@ def test_null_case_is_no_significant_gap(fmu_dir, tmp_path, measured, monkeypatc
     case = write_impedance_case(tmp_path / "damper_none", "none", seed=2)
     run = _diagnose_cli(case / "impedance_test.csv", tmp_path / "out", fmu_dir, "--workers", "1")
     assert run.returncode == 0, run.stderr[-3000:]
-    rep = json.loads((tmp_path / "out" / "report.json").read_text())
-    assert rep["verdict"] == "no significant gap" and rep["ranking"] == []
+    rep = Diagnosis.read(tmp_path / "out" / "report.json")
+    assert rep.verdict is Verdict.NO_GAP and rep.ranking == ()
     measured("impedance diagnosis, null case: held-out misfit of the calibrated linear damper (RMS |Z/Z_meas − 1|)",
-             rep["heldout_error_nominal"], 1.2 * IMPEDANCE_UNCERTAINTY)
+             rep.gap.overall, 1.2 * IMPEDANCE_UNCERTAINTY)
     assert "no significant gap" in (tmp_path / "out" / "report.md").read_text()
     again = _rerun_from_stored_fits(monkeypatch, case / "impedance_test.csv", tmp_path / "out", fmu_dir=fmu_dir)
-    assert again["heldout_error_nominal"] == rep["heldout_error_nominal"]
+    assert again.gap.overall == rep.gap.overall
 
 
 @pytest.mark.slow
@@ -64,18 +64,18 @@ def test_withheld_cubic_stiffness_is_named(fmu_dir, tmp_path, measured, monkeypa
     case = write_impedance_case(tmp_path / "damper_cubic", "cubic_stiffness")
     cfg = DiagnoseConfig(**{**SHORT.__dict__, "effects": ["cubic_stiffness", "quadratic_damping"]})
     rep = diagnose_impedance(case / "impedance_test.csv", tmp_path / "out", cfg, fmu_dir, workers=2)
-    assert rep["verdict"] == "gap explained by cubic_stiffness", rep["ranking"]
-    top = rep["ranking"][0]
-    measured("impedance diagnosis, withheld cubic stiffness: held-out shrink [%]", top["shrink_pct"], 90.0,
+    assert rep.chosen == ("cubic_stiffness",), rep.ranking
+    top = rep.ranking[0]
+    measured("impedance diagnosis, withheld cubic stiffness: held-out shrink [%]", top.shrink_pct, 90.0,
              at_least=True)
     measured("impedance diagnosis, withheld cubic stiffness: held-out misfit after (RMS |Z/Z_meas − 1|)",
-             top["heldout_error_after"], IMPEDANCE_UNCERTAINTY)
+             top.heldout_gap_after, IMPEDANCE_UNCERTAINTY)
     truth = DAMPER.withheld["cubic_stiffness"]
     for name in ("k_cs1", "k_cs2"):
         measured(f"impedance diagnosis: fitted {name} relative to the withheld value",
-                 abs(top["params"][name] / truth[name] - 1), 0.05)
+                 abs(top.params[name] / truth[name] - 1), 0.05)
     again = _rerun_from_stored_fits(monkeypatch, case / "impedance_test.csv", tmp_path / "out", cfg, fmu_dir)
-    assert again["ranking"] == rep["ranking"]
+    assert again.ranking == rep.ranking
 
 
 def test_two_levels_cannot_be_diagnosed(tmp_path, fmu_dir):

@@ -1,7 +1,9 @@
 """The diagnosis report's text (pyfit.gap.report): how a candidate's listed starts are written in report.md, and
 what a gap no candidate explains is told with."""
 from pyfit.gap.diagnose import DiagnoseConfig
-from pyfit.gap.report import LISTED_IN_FULL, POOR_LINEAR_NRMSE, not_explained_lines, starts_text
+from pyfit.gap.evidence import POOR_LINEAR_NRMSE, not_explained_lines
+from pyfit.gap.report import LISTED_IN_FULL, starts_text
+from pyfit.gap.result import Diagnosis, Gap, ModelFit, NominalFit, Verdict
 from pyfit.gap.systems import FAMILY, SDOF_EFFECTS, Scale
 
 
@@ -23,10 +25,17 @@ def test_many_starts_are_summarised_by_parameter():
     assert text.endswith("(each start in report.json, `listed_starts`)")
 
 
+def _fit(effect: str, shrink_pct: float, after: float) -> ModelFit:
+    return ModelFit(effect, tuple(effect.split(" + ")), shrink_pct, 0.6, after, shrink_pct, {}, 1, 0.1, 100, False)
+
+
+GAP = Gap(overall=0.6, noise_floor=0.01, noise_floor_scaled=0.01, noise_floor_method=(), significant=True,
+          worst_band_hz=(4.7, 6.1), by_band=(), by_level=())
+
+
 def _unexplained(best_calibration_nrmse: float, shrinks: dict) -> list[str]:
-    ranking = [{"effect": n, "shrink_pct": v, "heldout_gap_after": 0.5} for n, v in shrinks.items()]
-    gap = {"noise_floor": 0.01, "worst_band_hz": (4.7, 6.1)}
-    return not_explained_lines(ranking[0], ranking, gap, (best_calibration_nrmse, "level1"), 0.05, DiagnoseConfig(),
+    ranking = [_fit(n, v, 0.5) for n, v in shrinks.items()]
+    return not_explained_lines(ranking[0], ranking, GAP, (best_calibration_nrmse, "level1"), 0.05, DiagnoseConfig(),
                                FAMILY["sdof"].outside)
 
 
@@ -77,7 +86,7 @@ def test_a_misfit_confined_to_a_few_seconds_is_found_with_the_rest_of_the_record
     import numpy as np
 
     from pyfit.gap.localise import confined_misfit
-    from pyfit.gap.report import confined_lines
+    from pyfit.gap.evidence import confined_lines
 
     sims, held = _held_out()
     found = confined_misfit(sims, held)
@@ -101,22 +110,27 @@ def test_the_prediction_band_is_asked_for_a_confined_misfit_of_a_model_that_remo
 
     from pyfit.gap.band import PredictionBand
     from pyfit.gap.localise import confined_misfit
-    from pyfit.gap.report import band_lines, needs_band
+    from pyfit.gap.evidence import band_lines
+    from pyfit.gap.judge import needs_band
 
     sims, held = _held_out()
     confined = confined_misfit(sims, held)
-    best = {"effect": "hysteresis + cubic_stiffness", "shrink_pct": 92.5, "heldout_gap_after": 0.037}
-    result = {"verdict": "gap not explained by the candidate effects", "ranking": [best], "explained_below": 0.0284,
-              "confined_misfit": dataclasses.asdict(confined)}
+    best = _fit("hysteresis + cubic_stiffness", 92.5, 0.037)
+    result = Diagnosis("damper", "StockbridgeDamper", "", Verdict.NOT_EXPLAINED, (), 0.0284, GAP, (best,), (),
+                       NominalFit({}, 0.1, 60), (), (), confined_misfit=dataclasses.asdict(confined))
+
+    def but(**changes):
+        return dataclasses.replace(result, **changes)
+
     assert needs_band(result, 50.0) == "hysteresis + cubic_stiffness"
-    assert needs_band({**result, "explained_below": 0.005}, 50.0) is None  # the rest above the criterion
+    assert needs_band(but(explained_below=0.005), 50.0) is None  # the rest above the criterion
     assert needs_band(result, 95.0) is None  # removes too little of the gap
-    assert needs_band({**result, "verdict": "gap explained by hysteresis"}, 50.0) is None
-    assert needs_band({**result, "verdict": "nominal model does not fit"}, 50.0) is None
-    assert needs_band({**result, "confined_misfit": None}, 50.0) is None  # a misfit spread over the record
+    assert needs_band(but(verdict=Verdict.EXPLAINED, chosen=("hysteresis",)), 50.0) is None
+    assert needs_band(but(verdict=Verdict.NOMINAL_MISFITS), 50.0) is None
+    assert needs_band(but(confined_misfit=None), 50.0) is None  # a misfit spread over the record
     band = PredictionBand("hysteresis + cubic_stiffness", 0.0053, 22, 22, 28, {"k_bw1": 0.017}, {"k_bw1": 610.0},
                           0.01293, 0.01290, 0.0109)
-    line, = band_lines({**best, "prediction_band": dataclasses.asdict(band)}, confined, 0.0284)
+    line, = band_lines(dataclasses.replace(best, prediction_band=dataclasses.asdict(band)), confined, 0.0284)
     assert "held-out NRMSE 0.0370 is above the criterion 0.0284" in line
     assert "in 2.0 s (level2 14.0-16.0 s)" in line
     assert "within 0.53 % of the fit's 0.0129: 22 of the 22 ends of its axes" in line

@@ -92,8 +92,8 @@ def test_the_docs_maxwell_candidate_is_built_declared_and_named(tmp_path, fmu_di
     declared = _write(tmp_path, (EXAMPLE / "maxwell.toml").read_text())  # its fmu is fmus/ beside it
     data = _maxwell_dataset(tmp_path / "data", k_m=3e4, tau=1 / (2 * np.pi * 35.0))
     rep = diagnose("sdof", data, tmp_path / "out", fmu_dir=fmu_dir, workers=2, progress=False, candidates=declared)
-    assert rep["chosen_effect"] == "maxwell_damping", (rep["verdict"], rep["ranking"][:2])
-    best = rep["ranking"][0]
+    assert rep.chosen_name == "maxwell_damping", (rep.sentence, rep.ranking[:2])
+    best = rep.ranking[0]
     measured("a user-declared candidate (Maxwell element) on data that has it: held-out shrink [%]",
-             best["shrink_pct"], 90.0, at_least=True)
-    measured("the same: fitted k_m relative to the truth", abs(best["params"]["k_m"] / 3e4 - 1), 0.05)
+             best.shrink_pct, 90.0, at_least=True)
+    measured("the same: fitted k_m relative to the truth", abs(best.params["k_m"] / 3e4 - 1), 0.05)

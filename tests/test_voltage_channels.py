@@ -48,9 +48,9 @@ def test_an_sdof_driven_and_recorded_in_volts_is_diagnosed_in_the_units_the_gain
     root, data, truth, (G, H) = random_sdof
     volts = _rewritten(data, root / "volts", G, H)
     rep = dg.diagnose("sdof", volts, root / "out", CI, fmu_dir, workers=2, progress=False)
-    assert rep["chosen_effect"] == "cubic_stiffness", rep["verdict"]
-    assert rep["voltage_channels"] == ["drive (u)", "sensor (y)"]
-    fitted = rep["ranking"][0]["params"]
+    assert rep.chosen_name == "cubic_stiffness", rep.sentence
+    assert rep.voltage_channels == ("drive (u)", "sensor (y)")
+    fitted = rep.ranking[0].params
     # each fitted value times its gains is the truth's (SI); the natural frequency carries no gain
     measured("SDOF in volts (drive 5-50 N/V, sensor 100-2000 V/m, random): |k3' G H^3 / k3 - 1|",
              abs(fitted["k3"] * G * H ** 3 / truth["k3"] - 1.0), 0.02)

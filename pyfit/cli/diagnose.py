@@ -119,6 +119,6 @@ def run(args, ap) -> int:
     except (ConfigError, ValueError, OSError) as exc:  # OSError: a file not found, a scheduler not answering
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    print(json.dumps({k: report[k] for k in ("verdict", "chosen_effect")}, indent=1))
+    print(json.dumps({"verdict": report.verdict.value, "chosen_effects": list(report.chosen)}, indent=1))
     print(f"report: {pathlib.Path(args.out) / 'report.md'}")
     return 0

@@ -114,18 +114,33 @@ def write_report(result: DesignResult, out_dir) -> pathlib.Path:
     """design_check.md (+ .json, damper_power.csv and the figures) into out_dir; returns the md path."""
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    d, fat, freqs = result.design, result.fatigue, result.table.frequencies
+    result.table.save(out / "damper_power.csv")
+    md = out / "design_check.md"
+    md.write_text("\n".join(_summary_lines(result) + _fatigue_lines(result)) + "\n")
+    (out / "design_check.json").write_text(json.dumps({
+        "conductor": d.conductor.name, "span_m": d.length, "tension_n": d.tension, "band_hz": [freqs[0], freqs[-1]],
+        "bare_use": result.bare.use,
+        "best": {str(n): {"positions_m": list(cfg.positions), "use": cfg.use} for n, cfg in result.best.items()},
+        "recommended_positions_m": list(result.recommended.positions), **fat}, indent=2, default=float))
+    _figures(result, out)
+    return md
+
+
+def _summary_lines(result: DesignResult) -> list[str]:
+    """The verdict, the span, conductor, damper, self-damping and wind, and the best configuration per count."""
     d, c, fat = result.design, result.design.conductor, result.fatigue
     freqs = result.table.frequencies
-    result.table.save(out / "damper_power.csv")
     law = f"{d.self_damping[0].label}, k = {d.self_damping[1]:.4g}" if d.self_damping else f"viscous ζ = {d.zeta:g}"
     verdict = "PASSES" if fat["passes"] else "FAILS"
     damper = (f"measured impedance `{d.impedance_file.name}`" if d.impedance_file else "DamperElement FMU" + (
         " with " + ", ".join(f"{k} = {v:g}" for k, v in sorted(d.damper_parameters.items()))
         if d.damper_parameters else " (the reference damper of theory §1.3)"))
-    lines = [f"# Span design check: {c.name}, {d.length:g} m at {d.tension / 1e3:.1f} kN ({d.tension / c.rts:.0%} RTS)", "",
-             f"**The span {verdict} with {len(result.recommended.positions)} damper(s) at {_positions(result.recommended)} "
-             f"from the suspension clamp: the worst fatigue use is {1 - fat['margin']:.2f} of the limit, a margin of "
-             f"{fat['margin']:.0%}** (use: the larger of the CIGRE and IEEE uses below).", "",
+    lines = [f"# Span design check: {c.name}, {d.length:g} m at {d.tension / 1e3:.1f} kN ({d.tension / c.rts:.0%} RTS)",
+             "", f"**The span {verdict} with {len(result.recommended.positions)} damper(s) at "
+             f"{_positions(result.recommended)} from the suspension clamp: the worst fatigue use is "
+             f"{1 - fat['margin']:.2f} of the limit, a margin of {fat['margin']:.0%}** (use: the larger of the CIGRE "
+             "and IEEE uses below).", "",
              f"Conductor: D = {c.diameter * 1e3:.2f} mm, {c.mass_per_length:g} kg/m, RTS {c.rts / 1e3:.1f} kN, "
              f"EI {c.ei_min:.1f}–{c.ei_max:.0f} N·m², outer wires {c.outer_wire_diameter * 1e3:.2f} mm, "
              f"{c.aluminium_layers} aluminium layer(s). Damper: {damper}. Self-damping: {law}. Wind: {d.wind.label}; "
@@ -141,33 +156,37 @@ def write_report(result: DesignResult, out_dir) -> pathlib.Path:
         else:
             lines.append(f"| {n} | unresolved at every position: at {_unresolved(cfg, freqs)} the balance needs "
                          "clamp amplitudes beyond those the damper FMU ran at | — | — |")
-    lines += ["", f"Recommended (fewest dampers that pass, else the lowest use): {_positions(result.recommended)}.", "",
-              "| fatigue of the recommended configuration | value |", "|---|---|",
-              f"| endurance stress, CIGRE safe border line at 5·10⁸ cycles | {fat['endurance_stress_pa'] / 1e6:.2f} MPa |",
-              f"| max bending stress σ_a at the clamp (EI_min; EI_max) | {fat['max_stress_pa'] / 1e6:.2f} MPa; "
-              f"{fat['max_stress_ei_max_pa'] / 1e6:.2f} MPa |",
-              f"| CIGRE use | {fat['cigre_use']:.3f} |",
-              f"| max bending strain at 89 mm, peak to peak (IEEE limit 150 µε) | {fat['max_strain_pp'] * 1e6:.1f} µε |",
-              f"| IEEE use | {fat['ieee_use']:.3f} |",
-              f"| cycles per year (aeolian fraction {d.climate.aeolian_fraction:g}) | {fat['yearly_cycles']:.3g} |",
-              f"| Miner damage per year (safe border line as S-N curve) | {fat['yearly_damage']:.3g} |",
-              f"| life at that rate | {fat['life_years']:.3g} years |", "",
-              "![antinode amplitude over the band, without and with the best configurations](design_amplitude.png)",
-              "", "![stress at the clamp and the endurance line](design_stress.png)", "",
-              "![worst-case use of one damper against its position](design_positions.png)"]
-    md = out / "design_check.md"
-    md.write_text("\n".join(lines) + "\n")
-    (out / "design_check.json").write_text(json.dumps({
-        "conductor": c.name, "span_m": d.length, "tension_n": d.tension, "band_hz": [freqs[0], freqs[-1]],
-        "bare_use": result.bare.use,
-        "best": {str(n): {"positions_m": list(cfg.positions), "use": cfg.use} for n, cfg in result.best.items()},
-        "recommended_positions_m": list(result.recommended.positions), **fat}, indent=2, default=float))
+    return lines
+
+
+def _fatigue_lines(result: DesignResult) -> list[str]:
+    """The recommended configuration's fatigue table and the figures."""
+    fat, d = result.fatigue, result.design
+    return ["", f"Recommended (fewest dampers that pass, else the lowest use): {_positions(result.recommended)}.", "",
+            "| fatigue of the recommended configuration | value |", "|---|---|",
+            f"| endurance stress, CIGRE safe border line at 5·10⁸ cycles | {fat['endurance_stress_pa'] / 1e6:.2f} MPa |",
+            f"| max bending stress σ_a at the clamp (EI_min; EI_max) | {fat['max_stress_pa'] / 1e6:.2f} MPa; "
+            f"{fat['max_stress_ei_max_pa'] / 1e6:.2f} MPa |",
+            f"| CIGRE use | {fat['cigre_use']:.3f} |",
+            f"| max bending strain at 89 mm, peak to peak (IEEE limit 150 µε) | {fat['max_strain_pp'] * 1e6:.1f} µε |",
+            f"| IEEE use | {fat['ieee_use']:.3f} |",
+            f"| cycles per year (aeolian fraction {d.climate.aeolian_fraction:g}) | {fat['yearly_cycles']:.3g} |",
+            f"| Miner damage per year (safe border line as S-N curve) | {fat['yearly_damage']:.3g} |",
+            f"| life at that rate | {fat['life_years']:.3g} years |", "",
+            "![antinode amplitude over the band, without and with the best configurations](design_amplitude.png)",
+            "", "![stress at the clamp and the endurance line](design_stress.png)", "",
+            "![worst-case use of one damper against its position](design_positions.png)"]
+
+
+def _figures(result: DesignResult, out: pathlib.Path) -> None:
+    """The antinode amplitude and the clamp stress over the band, and one damper's use against its position."""
+    freqs, d = result.table.frequencies, result.design
     styles = ["o-", "s-", "^-", "d-"]
     configs = [("no damper", result.bare, "k-")] + [
         (f"{n} at {_positions(cfg)}", cfg, styles[n - 1]) for n, cfg in sorted(result.best.items())]
     plots.semilogy_curves(out / "design_amplitude.png", [(lab, freqs, cfg.amplitudes * 1e3, st) for lab, cfg, st in configs],
                           "frequency [Hz]", "steady antinode amplitude Y [mm]", "Energy balance over the aeolian band")
-    limit = fat["endurance_stress_pa"] / 1e6
+    limit = result.fatigue["endurance_stress_pa"] / 1e6
     plots.semilogy_curves(out / "design_stress.png", [(lab, freqs, cfg.stress / 1e6, st) for lab, cfg, st in configs]
                           + [("endurance (CIGRE SBL, 5e8 cycles)", freqs[[0, -1]], [limit, limit], "r--")],
                           "frequency [Hz]", "bending stress σ_a at the clamp [MPa]",
@@ -178,4 +197,3 @@ def write_report(result: DesignResult, out_dir) -> pathlib.Path:
                            ("limit", list(d.x_range), [1.0, 1.0], "r--")],
                           "damper position from the clamp [m]", "worst-case CIGRE use over the band [-]",
                           "Position sweep, one damper", log=False)
-    return md

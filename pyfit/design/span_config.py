@@ -97,13 +97,8 @@ def _conductor(doc: dict, path) -> ConductorType:
     return ConductorType(**c)
 
 
-def load_span_design(path) -> SpanDesign:
-    """Read and check a SPAN.toml; errors name the file and key (pyfit.io.schema format)."""
-    path = pathlib.Path(path)
-    doc = read_toml(path)
-    check_sections(doc, path, ("conductor", "span", "self_damping", "wind", "damper", "placement"),
-                   required=("conductor", "span"))
-    conductor = _conductor(doc, path)
+def _tension(doc, path, conductor) -> tuple[float, float]:
+    """[span]: its length [m] and the tension [N] (given, or as a share of the conductor's RTS)."""
     span = check_table(doc["span"], path, "span", {"length": ("number", True, None),
                                                    "tension_rts": ("number", False, None),
                                                    "tension": ("number", False, None)})
@@ -112,19 +107,29 @@ def load_span_design(path) -> SpanDesign:
     tension = span["tension"] if span["tension"] is not None else span["tension_rts"] * conductor.rts
     _positive(path, "span.tension", tension)
     _positive(path, "span.length", span["length"])
+    return span["length"], tension
+
+
+def _self_damping(doc, path, conductor) -> tuple:
+    """[self_damping]: a power law and its constant (None for the viscous law), and the viscous damping ratio."""
     sd = check_table(doc.get("self_damping", {}), path, "self_damping",
                      {"law": (str, False, "noiseux1991"), "k": ("number", False, None), "zeta": ("number", False, None)})
     if sd["law"] == "viscous":
         if sd["zeta"] is None:
             fail(path, "self_damping.zeta", "missing (the viscous law needs the modal damping ratio)")
-        self_damping = None
-    elif sd["law"] in SELF_DAMPING_LAWS:
-        self_damping = (SELF_DAMPING_LAWS[sd["law"]], sd["k"] if sd["k"] is not None else self_damping_constant(conductor))
-    else:
+        return None, sd["zeta"]
+    if sd["law"] not in SELF_DAMPING_LAWS:
         fail(path, "self_damping.law", f"unknown law {sd['law']!r}", ", ".join([*SELF_DAMPING_LAWS, "viscous"]))
+    law = SELF_DAMPING_LAWS[sd["law"]], sd["k"] if sd["k"] is not None else self_damping_constant(conductor)
+    return law, sd["zeta"] or 0.0
+
+
+def _wind(doc, path) -> tuple[WindPower, WindClimate]:
+    """[wind]: the wind power curve and turbulence, and the climate (Weibull speeds, aeolian range, Strouhal)."""
     defaults = WindClimate()
     w = check_table(doc.get("wind", {}), path, "wind", {
-        "curve": (str, False, "cigre"), "turbulence": ("number", False, 0.0), "weibull_shape": ("number", False, defaults.weibull_shape),
+        "curve": (str, False, "cigre"), "turbulence": ("number", False, 0.0),
+        "weibull_shape": ("number", False, defaults.weibull_shape),
         "weibull_scale": ("number", False, defaults.weibull_scale), "speed_range": ("floats", False, None),
         "strouhal": ("floats", False, None), "aeolian_fraction": ("number", False, defaults.aeolian_fraction)})
     if w["curve"] not in CURVES:
@@ -135,31 +140,61 @@ def load_span_design(path) -> SpanDesign:
     strouhal = check_bounds(w["strouhal"], path, "wind.strouhal") if w["strouhal"] else defaults.strouhal
     if not 0 < w["aeolian_fraction"] <= 1:
         fail(path, "wind.aeolian_fraction", f"{w['aeolian_fraction']} is not a fraction", "0 < value ≤ 1")
-    climate = WindClimate(_positive(path, "wind.weibull_shape", w["weibull_shape"]),
-                          _positive(path, "wind.weibull_scale", w["weibull_scale"]), speed_range, strouhal,
-                          w["aeolian_fraction"])
+    return WindPower(w["curve"], w["turbulence"]), WindClimate(
+        _positive(path, "wind.weibull_shape", w["weibull_shape"]),
+        _positive(path, "wind.weibull_scale", w["weibull_scale"]), speed_range, strouhal, w["aeolian_fraction"])
+
+
+def _placement(doc, path) -> dict:
+    pl = check_table(doc.get("placement", {}), path, "placement", {
+        "max_dampers": (int, False, 2), "x_range": ("floats", False, None), "step": ("number", False, 0.25),
+        "min_spacing": ("number", False, 0.5)})
+    if not 1 <= pl["max_dampers"] <= 4:
+        fail(path, "placement.max_dampers", f"{pl['max_dampers']}", "1 to 4")
+    pl["x_range"] = check_bounds(pl["x_range"], path, "placement.x_range") if pl["x_range"] else (0.5, 3.0)
+    return pl
+
+
+def _damper(doc, path) -> dict:
+    """[damper]: the FMU's parameters (a nominal file and overrides) or a measured impedance, and the table's
+    amplitudes and grid."""
     d = check_table(doc.get("damper", {}), path, "damper", {
         "nominal": (str, False, None), "parameters": (dict, False, {}), "impedance_file": (str, False, None),
         "amplitudes": ("floats", False, None),
         "n_amplitudes": (int, False, 10), "n_frequencies": (int, False, 20)})
     params = load_nominal(path.parent / d["nominal"]).parameters() if d["nominal"] else {}
     params.update(check_numbers(d["parameters"], path, "damper.parameters"))
-    amplitudes = check_bounds(d["amplitudes"], path, "damper.amplitudes") if d["amplitudes"] else (1e-5, 3e-2)
-    pl = check_table(doc.get("placement", {}), path, "placement", {
-        "max_dampers": (int, False, 2), "x_range": ("floats", False, None), "step": ("number", False, 0.25),
-        "min_spacing": ("number", False, 0.5)})
-    if not 1 <= pl["max_dampers"] <= 4:
-        fail(path, "placement.max_dampers", f"{pl['max_dampers']}", "1 to 4")
-    x_range = check_bounds(pl["x_range"], path, "placement.x_range") if pl["x_range"] else (0.5, 3.0)
+    d["parameters"] = params
+    d["amplitudes"] = check_bounds(d["amplitudes"], path, "damper.amplitudes") if d["amplitudes"] else (1e-5, 3e-2)
+    return d
+
+
+def _check_damper(d: dict, path) -> pathlib.Path | None:
+    """The damper table's grid sizes, and its measured impedance file (which replaces the FMU) if any."""
     for key in ("n_amplitudes", "n_frequencies"):
         if d[key] < 2:
             fail(path, f"damper.{key}", f"{d[key]}", "at least 2")
     impedance_file = path.parent / d["impedance_file"] if d["impedance_file"] else None
-    if impedance_file is not None and (params or d["nominal"]):
+    if impedance_file is not None and (d["parameters"] or d["nominal"]):
         fail(path, "damper.impedance_file", "a measured impedance replaces the damper FMU: give no nominal or "
              "parameters with it")
-    return SpanDesign(path, conductor, span["length"], tension, self_damping, sd["zeta"] or 0.0,
-                      WindPower(w["curve"], w["turbulence"]),
-                      climate, params, impedance_file, amplitudes, d["n_amplitudes"], d["n_frequencies"], pl["max_dampers"],
-                      x_range, _positive(path, "placement.step", pl["step"]),
+    return impedance_file
+
+
+def load_span_design(path) -> SpanDesign:
+    """Read and check a SPAN.toml; errors name the file and key (pyfit.io.schema format)."""
+    path = pathlib.Path(path)
+    doc = read_toml(path)
+    check_sections(doc, path, ("conductor", "span", "self_damping", "wind", "damper", "placement"),
+                   required=("conductor", "span"))
+    conductor = _conductor(doc, path)
+    length, tension = _tension(doc, path, conductor)
+    self_damping, zeta = _self_damping(doc, path, conductor)
+    power, climate = _wind(doc, path)
+    d = _damper(doc, path)
+    pl = _placement(doc, path)
+    impedance_file = _check_damper(d, path)
+    return SpanDesign(path, conductor, length, tension, self_damping, zeta, power, climate, d["parameters"],
+                      impedance_file, d["amplitudes"], d["n_amplitudes"], d["n_frequencies"], pl["max_dampers"],
+                      pl["x_range"], _positive(path, "placement.step", pl["step"]),
                       _positive(path, "placement.min_spacing", pl["min_spacing"]))

@@ -117,108 +117,131 @@ BASINS_ON = 2
 BOUND_MARGIN = 1e-3
 
 
-def run_fit(task: FitTask) -> Fit:
-    """Least squares on the stacked calibration residuals within task.bounds, from the best of task.start and
-    task.alternatives (more than SCREEN_FROM of them ranked at upsample 1 first, then the best of each basin at
-    task.upsample); with task.continuation in stages, each from the best point so far (by the residual of
-    every record): the envelopes of non-periodic records (a third of the budget), the lowest level alone (a
-    quarter), then every record. Never worse than the best start: each stage and the last least squares keep
-    the best point they evaluated. With task.basin the same from the best start of each basin (an SDOF loop
-    has one at each ν, which sets the scale of β, and width: systems.sdof_loop_basin), each with BASIN_SHARE
-    of the budget first, then the BASINS_ON best of them each with the whole budget; without it, likewise from the
-    task.probes best starts and task.probed (a combination's starts lead to different local optima of its many
-    parameters). With task.envelopes, all of it on the amplitude envelopes instead of the waveforms."""
-    t0 = time.perf_counter()
-    threads = max(1, min(task.threads, len(task.records)))
-    runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
-    pool = ThreadPoolExecutor(threads) if threads > 1 else None
-    names = list(task.start)
-    unit = UnitScaling(names, task.bounds, task.log_scaled)
+class _Evaluator:
+    """A fit's simulations: its FMU instances (one per record simulated at once), the unit scaling of its free
+    parameters and the residual it minimises (the waveforms', or the amplitude envelopes')."""
 
-    def params(x):
-        return with_derived({**task.fixed, **unit.values(x)}, task.derived)
+    def __init__(self, task: FitTask):
+        self.task = task
+        threads = max(1, min(task.threads, len(task.records)))
+        self.runner = [FmuRunner(task.fmu) for _ in task.records] if threads > 1 else FmuRunner(task.fmu)
+        self.pool = ThreadPoolExecutor(threads) if threads > 1 else None
+        self.unit = UnitScaling(list(task.start), task.bounds, task.log_scaled)
+        self.objective = sim.envelope_residuals if task.envelopes else sim.residuals
 
-    objective = sim.envelope_residuals if task.envelopes else sim.residuals
+    def params(self, x) -> dict:
+        return with_derived({**self.task.fixed, **self.unit.values(x)}, self.task.derived)
 
-    def residuals(p, records=task.records, of=objective, upsample=task.upsample):
-        return stacked_residuals(runner, records, p, upsample, task.lead_periods, pool, of)
+    def residuals(self, p, records=None, of=None, upsample=None) -> np.ndarray:
+        t = self.task
+        return stacked_residuals(self.runner, t.records if records is None else records, p,
+                                 t.upsample if upsample is None else upsample, t.lead_periods, self.pool,
+                                 of or self.objective)
 
-    def cost(x, upsample=task.upsample):
-        return float(np.sum(residuals(params(x), upsample=upsample) ** 2))
+    def cost(self, x, upsample=None) -> float:
+        return float(np.sum(self.residuals(self.params(x), upsample=upsample) ** 2))
 
-    # find the basins: the starts with the best time-domain residual
-    candidates = [unit.scaled(task.start)] + [unit.scaled({**task.start, **alt})
-                                              for alt in task.alternatives + task.probed]
+    def close(self) -> None:
+        for r in self.runner if isinstance(self.runner, list) else [self.runner]:
+            r.close()
+        if self.pool:
+            self.pool.shutdown()
+
+
+def _ranked_starts(task: FitTask, ev: _Evaluator) -> tuple[list, list, range, int]:
+    """The starts (unit-scaled), each one's cost (inf where not evaluated), the indices of task.probed among them
+    and the evaluations spent: more than SCREEN_FROM starts are ranked at upsample 1 first, then the best
+    SCREEN_KEPT of each basin (at least task.probes) again at task.upsample."""
+    candidates = [ev.unit.scaled(task.start)] + [ev.unit.scaled({**task.start, **alt})
+                                                 for alt in task.alternatives + task.probed]
     forced = range(len(candidates) - len(task.probed), len(candidates))
     kept, used = range(len(candidates)), 0
     if len(candidates) > SCREEN_FROM and task.upsample > 1:
-        coarse = [cost(x, upsample=1) for x in candidates]
-        group = (lambda k: task.basin(unit.values(candidates[k]))) if task.basin else (lambda k: None)
+        coarse = [ev.cost(x, upsample=1) for x in candidates]
+        group = (lambda k: task.basin(ev.unit.values(candidates[k]))) if task.basin else (lambda k: None)
         ranked = {}
         for k in np.argsort(coarse):
             ranked.setdefault(group(k), []).append(int(k))
         kept = {0, *forced, *(k for ks in ranked.values() for k in ks[:max(SCREEN_KEPT, task.probes)])}
         used = len(candidates)
-    errors = [cost(x) if k in kept else np.inf for k, x in enumerate(candidates)]
-    used += len(kept)
+    errors = [ev.cost(x) if k in kept else np.inf for k, x in enumerate(candidates)]
+    return candidates, errors, forced, used + len(kept)
+
+
+def _stages(task: FitTask, objective) -> list[tuple]:
+    """The continuation's stages (records, residual, part of the budget): a sweep's envelopes first (smooth in the
+    parameters where the waveform is not), then the lowest level alone (where an amplitude-dependent effect is
+    weakest and the residual smooth)."""
     stages = []
     if task.continuation and not task.envelopes and not any(r.periodic for r in task.records):
-        # a sweep's envelopes first (all levels): smooth in the parameters where the waveform is not
         stages.append((task.records, sim.envelope_residuals, 3))
     levels = sorted({r.level_value for r in task.records})
     if task.continuation and len(levels) > 1:
-        # continuation in amplitude: the lowest level alone, where an amplitude-dependent effect is weakest
-        # and the residual smooth in the parameters (a hardening spring jumps on a sweep at the highest level)
         stages.append(([r for r in task.records if r.level_value == levels[0]], objective, 4))
+    return stages
 
-    def descend(x0, e0, budget):
-        """The stages (each 1/part of the budget) then least squares on every record with what is left, each
-        from the best point so far; never worse than the start."""
-        n, whole = 0, budget
-        for records, of, part in stages:
-            stage = polish(lambda x: residuals(params(x), records, of), x0, budget=whole // part,
-                           margin=BOUND_MARGIN)
-            e = cost(stage.x)
-            x0, e0 = (stage.x, e) if e < e0 else (x0, e0)
-            n, budget = n + 1 + stage.n_evaluations, budget - stage.n_evaluations
-        result = polish(lambda x: residuals(params(x)), x0, budget=budget, margin=BOUND_MARGIN)
-        n += result.n_evaluations
-        return (result.x, result.error, n) if result.error <= e0 else (x0, e0, n)
 
-    # from the best start; with task.basin, from the best start of each basin, else from the
-    # task.probes best starts, each descended with a share of the budget (BASIN_SHARE), then the best of them (of
-    # the basins: the BASINS_ON best) on with the whole budget
-    order = np.argsort(errors)
-    best_x, error = candidates[order[0]], errors[order[0]]
+def _descend(ev: _Evaluator, stages, x0, e0, budget) -> tuple:
+    """The stages (each 1/part of the budget) then least squares on every record with what is left, each from the
+    best point so far; never worse than the start. Returns (x, cost, evaluations)."""
+    n, whole = 0, budget
+    for records, of, part in stages:
+        stage = polish(lambda x: ev.residuals(ev.params(x), records, of), x0, budget=whole // part,
+                       margin=BOUND_MARGIN)
+        e = ev.cost(stage.x)
+        x0, e0 = (stage.x, e) if e < e0 else (x0, e0)
+        n, budget = n + 1 + stage.n_evaluations, budget - stage.n_evaluations
+    result = polish(lambda x: ev.residuals(ev.params(x)), x0, budget=budget, margin=BOUND_MARGIN)
+    n += result.n_evaluations
+    return (result.x, result.error, n) if result.error <= e0 else (x0, e0, n)
+
+
+def _probe_starts(task: FitTask, ev: _Evaluator, candidates, order, forced) -> dict:
+    """The starts descended as probes: with task.basin the best of each basin, else the task.probes best and
+    task.probed ({} when none: the best start goes on alone)."""
     firsts = {}
     if task.basin:
         for k in order:
-            firsts.setdefault(task.basin(unit.values(candidates[k])), k)
+            firsts.setdefault(task.basin(ev.unit.values(candidates[k])), k)
     elif task.probes > 1 or task.probed:
         firsts = dict(enumerate(order[:task.probes]))
         firsts.update({f"probed {k}": k for k in forced if k not in firsts.values()})
-    probed = [descend(candidates[k], errors[k], max(1, int(task.budget * BASIN_SHARE))) for k in firsts.values()]
+    return firsts
+
+
+def run_fit(task: FitTask) -> Fit:
+    """Least squares on the stacked calibration residuals within task.bounds, from the best of task.start and
+    task.alternatives (_ranked_starts); with task.continuation in stages (_stages), each from the best point so
+    far. Never worse than the best start. With task.basin the same from the best start of each basin (an SDOF loop
+    has one at each ν: systems.sdof_loop_basin), each with BASIN_SHARE of the budget first, then the BASINS_ON best
+    of them with the whole budget; without it, likewise from the task.probes best starts and task.probed. With
+    task.envelopes, all of it on the amplitude envelopes instead of the waveforms; never worse than task.floor."""
+    t0 = time.perf_counter()
+    ev = _Evaluator(task)
+    candidates, errors, forced, used = _ranked_starts(task, ev)
+    stages = _stages(task, ev.objective)
+    order = np.argsort(errors)
+    firsts = _probe_starts(task, ev, candidates, order, forced)
+    probed = [_descend(ev, stages, candidates[k], errors[k], max(1, int(task.budget * BASIN_SHARE)))
+              for k in firsts.values()]
     used += sum(n for _, _, n in probed)
-    ahead = sorted(probed, key=lambda end: end[1])[:BASINS_ON if task.basin else 1] or [(best_x, error, 0)]
-    ends = [descend(x, e, task.budget) for x, e, _ in ahead]  # the best probes (or start) on with the whole budget
+    ahead = sorted(probed, key=lambda end: end[1])[:BASINS_ON if task.basin else 1] or \
+        [(candidates[order[0]], errors[order[0]], 0)]
+    ends = [_descend(ev, stages, x, e, task.budget) for x, e, _ in ahead]
     used += sum(n for _, _, n in ends)
     best_x, error, _ = min(ends, key=lambda end: end[1])
-    best = params(best_x)
+    best = ev.params(best_x)
     if task.floor is not None:  # never worse than the nominal model (the effect at zero)
         floor = with_derived({**task.fixed, **task.floor}, task.derived)
-        e = float(np.sum(residuals(floor) ** 2))
+        e = float(np.sum(ev.residuals(floor) ** 2))
         used += 1
         if e < error:
             best, error = floor, e
     # the stacked residual's sum of squares is the weighted sum of every channel's squared NRMSE
     channels = sum(sum(r.weights.get(k, 1.0) for k in r.outputs) for r in task.records)
-    err = float(np.sqrt(error / channels))
-    for r in runner if isinstance(runner, list) else [runner]:
-        r.close()
-    if pool:
-        pool.shutdown()
-    return Fit(task.effect, {k: float(v) for k, v in best.items()}, names, task.n_added, err, used,
-               time.perf_counter() - t0)
+    ev.close()
+    return Fit(task.effect, {k: float(v) for k, v in best.items()}, list(task.start), task.n_added,
+               float(np.sqrt(error / channels)), used, time.perf_counter() - t0)
 
 
 def _free_basin(basin, free: dict):

@@ -32,6 +32,7 @@ import numpy as np
 
 from pyfit.gap import confidence, datasets, selection, sizing
 from pyfit.gap.diagnose import DiagnoseConfig, diagnose, load_config, misfit_at
+from pyfit.gap.result import Verdict
 from pyfit.gap.systems import FAMILY
 from pyfit.io.nominal import NominalModel
 from pyfit.runtime.batch import map_tasks
@@ -197,13 +198,7 @@ def run_case(job: CaseJob) -> dict:
     folder = pathlib.Path(job.out) / f"case{job.case.index:04d}"
     done = folder / "outcome.json"
     if done.is_file():
-        stored = json.loads(done.read_text())
-        report = folder / "diagnosis" / "report.json"
-        if "truth_shrink_pct" not in stored and stored.get("truth_held_out") is not None and report.is_file():
-            # stored before outcomes held the truth's own shrink: completed from the case's stored report
-            stored.update(truth_test(json.loads(report.read_text())["gap"], stored["truth_held_out"], job.cfg))
-            done.write_text(json.dumps(stored, indent=1, default=float))
-        return stored
+        return json.loads(done.read_text())
     t0 = time.perf_counter()
     c, data, described = write_case(job.case, folder / "data", job.record_s)
     written = time.perf_counter() - t0
@@ -213,23 +208,21 @@ def run_case(job: CaseJob) -> dict:
     try:
         rep = diagnose(c.model, data, folder / "diagnosis", job.cfg, job.fmu_dir, workers=1,
                        progress=False, nominal=described)
-        named, gap = rep["chosen_effect"], rep["gap"]
-        top = rep["ranking"][0]["shrink_pct"] if rep["ranking"] else None
-        outcome = {"named": "+".join(sorted((named or "").split(" + "))) or "none", "verdict": rep["verdict"],
-                   "enr": gap["overall"] / gap["noise_floor"], "top_shrink_pct": top,
-                   "stated": rep["confidence"]["rate"] if rep["confidence"] else None}
+        outcome = {"named": "+".join(sorted(rep.chosen)) or "none", "verdict": rep.verdict.value,
+                   "enr": rep.gap.overall / rep.gap.noise_floor,
+                   "top_shrink_pct": rep.best.shrink_pct if rep.best else None,
+                   "stated": rep.confidence["rate"] if rep.confidence else None}
         # from the truth (the diagnosis never reads it): each withheld effect's own size over the noise, and the
         # truth's own misfit on the diagnosis's split (the FMU at the true parameters over the calibrated
         # nominal's others), against which a miss is one the data cannot decide or one of the search
         truth = json.loads((data / "truth.json").read_text())
         outcome["member_to_noise"] = truth["member_to_noise"]
-        at_truth = misfit_at(c.model, data, {**rep["nominal"]["params"], **truth["params"]}, job.cfg,
+        at_truth = misfit_at(c.model, data, {**rep.nominal.params, **truth["params"]}, job.cfg,
                              fmu_dir=job.fmu_dir, nominal=described)
+        named = rep.fit_of(rep.chosen_name).heldout_gap_after if rep.chosen else rep.gap.overall
         outcome.update(truth_held_out=at_truth.held_out, truth_calibration=at_truth.calibration,
-                       named_held_out=next((d["heldout_gap_after"] for d in rep["ranking"] if d["effect"] == named),
-                                           gap["overall"]),
-                       noise_floor=gap["noise_floor"], explained_below=rep["explained_below"],
-                       **truth_test(gap, at_truth.held_out, job.cfg))
+                       named_held_out=named, noise_floor=rep.gap.noise_floor, explained_below=rep.explained_below,
+                       **truth_test(rep.gap.overall, rep.gap.shrink_reference, at_truth.held_out, job.cfg))
     except Exception as exc:  # a case that breaks the diagnosis is an outcome of the campaign, not its end
         outcome = {"named": "error", "verdict": f"{type(exc).__name__}: {exc}", "enr": None, "top_shrink_pct": None,
                    "stated": None}
@@ -253,13 +246,13 @@ def wall_of_runs(this_run: dict, n: int, earlier: dict | None) -> dict:
     return this_run
 
 
-def truth_test(gap: dict, truth_held_out: float, cfg: DiagnoseConfig) -> dict:
+def truth_test(before: float, shrink_reference: float, truth_held_out: float, cfg: DiagnoseConfig) -> dict:
     """What the report's test for 'explained' would make of the truth at its true parameters, had the search
     found it: its held-out shrink [%] of the gap, against the report's reference (the smaller of the noise floor
     should it grow with the level and every model's held-out misfit, the truth's among them), and the least shrink
     a named model must reach (cfg.min_shrink_pct)."""
-    reference = min(gap["shrink_reference"], truth_held_out)
-    return {"truth_shrink_pct": selection.shrink_pct(gap["overall"], truth_held_out, reference),
+    reference = min(shrink_reference, truth_held_out)
+    return {"truth_shrink_pct": selection.shrink_pct(before, truth_held_out, reference),
             "min_shrink_pct": cfg.min_shrink_pct}
 
 
@@ -416,7 +409,7 @@ def split_misses(effects: list[dict], nulls: list[dict]) -> dict:
 def _miss_cause(o: dict) -> str:
     """What kept a missed case's withheld effect(s) from being named (split_misses): the first that holds of
     undetected, undecided, unnamed; else search."""
-    if o["verdict"] == "no significant gap":
+    if o["verdict"] == Verdict.NO_GAP.value:
         return "undetected"
     if o["named_held_out"] <= o["truth_held_out"]:
         return "undecided"
@@ -465,94 +458,130 @@ def _share(part: int, whole: int) -> str:
 
 def markdown(s: dict) -> str:
     """The campaign summary as Markdown."""
+    lines = _headline_lines(s) + _confusion_lines(s) + _size_lines(s) + _miss_lines(s) + _time_lines(s) \
+        + _calibration_lines(s)
+    return "\n".join(lines) + "\n"
+
+
+def _headline_lines(s: dict) -> list[str]:
+    """What was run, where, how long it took; top-1 accuracy, false alarms and failures."""
     system = {"sdof": "SDOF", "damper": "damper (random geometry)"}[s.get("model", "sdof")]
     diagnosed = s["cases"] - s.get("resumed", 0)  # by this run
     lo, hi = sizing.SIZE_RANGE
     every = f", every case's excitation: {s['excitation'].replace('_', ' ')}" if s.get("excitation") else ""
-    lines = [f"{s['cases']} {system} cases (seed {s['seed']}{every}, records {s['record_s']:g} s, each withheld "
-             f"effect at {lo:g}–{hi:g} × the sensor noise), {s['where']}: wall "
-             f"{s['wall_s'] / 60:.1f} min"
-             + (f" for the {diagnosed} case{'' if diagnosed == 1 else 's'} this run diagnosed ({s['resumed']} read "
-                "from an earlier run" + (f", whose runs took {s['earlier_wall_s'] / 60:.1f} min: a full run takes "
-                                         f"at most {(s['wall_s'] + s['earlier_wall_s']) / 60:.1f} min"
-                                         if s.get("earlier_wall_s") else "") + ")" if s.get("resumed") else "")
-             + (f", median {s['median_case_s']:.0f} s per case diagnosed from scratch (writing the files and "
-                f"diagnosing)" if s["median_case_s"] is not None else "")
-             + f"; command: `{s['command']}`.", "",
-             f"Top-1 accuracy on the {s['effect_cases']} cases with a withheld effect: {100 * s['top1']:.0f} %; "
-             f"false alarms on the {s['null_cases']} null cases: {s['false_alarms']}; diagnoses that failed: "
-             f"{s['errors']}.", "", "**Confusion matrix** (rows: withheld; columns: named)", "",
+    resumed = ""
+    if s.get("resumed"):
+        earlier = (f", whose runs took {s['earlier_wall_s'] / 60:.1f} min: a full run takes at most "
+                   f"{(s['wall_s'] + s['earlier_wall_s']) / 60:.1f} min" if s.get("earlier_wall_s") else "")
+        resumed = (f" for the {diagnosed} case{'' if diagnosed == 1 else 's'} this run diagnosed ({s['resumed']} read "
+                   f"from an earlier run{earlier})")
+    median = (f", median {s['median_case_s']:.0f} s per case diagnosed from scratch (writing the files and "
+              "diagnosing)" if s["median_case_s"] is not None else "")
+    return [f"{s['cases']} {system} cases (seed {s['seed']}{every}, records {s['record_s']:g} s, each withheld "
+            f"effect at {lo:g}–{hi:g} × the sensor noise), {s['where']}: wall {s['wall_s'] / 60:.1f} min{resumed}"
+            f"{median}; command: `{s['command']}`.", "",
+            f"Top-1 accuracy on the {s['effect_cases']} cases with a withheld effect: {100 * s['top1']:.0f} %; "
+            f"false alarms on the {s['null_cases']} null cases: {s['false_alarms']}; diagnoses that failed: "
+            f"{s['errors']}.", ""]
+
+
+def _confusion_lines(s: dict) -> list[str]:
+    """The confusion matrix (withheld x named) and the hits by the number withheld."""
+    lines = ["**Confusion matrix** (rows: withheld; columns: named)", "",
              "| withheld \\ named | " + " | ".join(s["labels"]) + " |", "|---|" + "---|" * len(s["labels"])]
-    for w in s["labels"]:
-        if any(s["confusion"][w].values()):
-            lines.append(f"| {w} | " + " | ".join(str(s["confusion"][w][n] or "·") for n in s["labels"]) + " |")
+    lines += [f"| {w} | " + " | ".join(str(s["confusion"][w][n] or "·") for n in s["labels"]) + " |"
+              for w in s["labels"] if any(s["confusion"][w].values())]
     lines += ["", "**By the number withheld**", "", "| withheld | cases | named right | a pair named as one of its "
               "members |", "|---|---|---|---|"]
     lines += [f"| {b['kind']} | {b['cases']} | {_share(b['hits'], b['cases'])} | "
               f"{b['one_member'] if b['kind'] == 'pairs' else '—'} |" for b in s["by_size"]]
-    lines += ["", "**Detection limit**: top-1 accuracy by effect-to-noise ratio (nominal held-out misfit over "
-              "the noise floor)", "", "| effect-to-noise ratio | cases | named right |", "|---|---|---|"]
+    return lines
+
+
+def _size_lines(s: dict) -> list[str]:
+    """Top-1 accuracy by effect-to-noise ratio, and by the weakest withheld effect's own size."""
+    lines = ["", "**Detection limit**: top-1 accuracy by effect-to-noise ratio (nominal held-out misfit over "
+             "the noise floor)", "", "| effect-to-noise ratio | cases | named right |", "|---|---|---|"]
     lines += [f"| {confidence.range_label(*b['enr'])} | {b['cases']} | {_share(b['hits'], b['cases'])} |"
               for b in s["by_enr"]]
-    if any(b["single"]["cases"] + b["pair"]["cases"] for b in s.get("by_weakest", ())):
-        lines += ["", "**By the weakest withheld effect's own size**: the RMS of the truth less the truth with that "
-                  "effect off, over the RMS of the sensor noise (every level and output; before any model takes "
-                  "up part of it, so a pair's weaker member may be largely taken up by a refit of the other)", "",
-                  "| weakest effect's size over the noise | single effects | named right | pairs | named right | "
-                  "a pair named as one of its members |", "|---|---|---|---|---|---|"]
-        lines += [f"| {confidence.range_label(*b['size'])} | {b['single']['cases']} | "
-                  f"{_share(b['single']['hits'], b['single']['cases'])} | {b['pair']['cases']} | "
-                  f"{_share(b['pair']['hits'], b['pair']['cases'])} | {b['pair']['one_member']} |"
-                  for b in s["by_weakest"]]
+    if not any(b["single"]["cases"] + b["pair"]["cases"] for b in s.get("by_weakest", ())):
+        return lines
+    lines += ["", "**By the weakest withheld effect's own size**: the RMS of the truth less the truth with that "
+              "effect off, over the RMS of the sensor noise (every level and output; before any model takes "
+              "up part of it, so a pair's weaker member may be largely taken up by a refit of the other)", "",
+              "| weakest effect's size over the noise | single effects | named right | pairs | named right | "
+              "a pair named as one of its members |", "|---|---|---|---|---|---|"]
+    lines += [f"| {confidence.range_label(*b['size'])} | {b['single']['cases']} | "
+              f"{_share(b['single']['hits'], b['single']['cases'])} | {b['pair']['cases']} | "
+              f"{_share(b['pair']['hits'], b['pair']['cases'])} | {b['pair']['one_member']} |"
+              for b in s["by_weakest"]]
+    return lines
+
+
+def _miss_lines(s: dict) -> list[str]:
+    """The misses split by what kept the withheld effect(s) from being named, and the accuracy on the rest."""
     m = s.get("misses")
-    if m and m["judged"]:
-        lines += ["", "**Misses: the data or the search**: each miss's named model against the truth, both on the "
-                  "held-out files (the truth: the FMU at the true parameters over the calibrated nominal's others)",
-                  "", "| misses | cases |", "|---|---|",
-                  f"| undetected: verdict 'no significant gap' (the nominal within the noise threshold) | "
-                  f"{m['undetected']} |",
-                  f"| the named model fits the held-out files at least as well as the truth (the data do not favour "
-                  f"the truth) | {m['undecided']} |",
-                  f"| the truth fits them better but would itself not be named (its held-out shrink of the gap "
-                  f"below the least a named model needs, or its misfit above the explanation threshold) | "
-                  f"{m['unnamed']} |",
-                  f"| the truth fits them better and would be named (a miss of the search or of the selection) | "
-                  f"{m['search']} |", "",
-                  f"Top-1 accuracy on the {s['decided']} cases detected and decided by the data: "
-                  f"{100 * s['top1_decided']:.0f} %."]
-        if m["handicap"] is not None:
-            lines += ["", f"The truth at its true parameters carries the sensor chain (anti-alias filter, "
-                      f"decimation) and the other simulator, which a calibration takes up: on the null cases its "
-                      f"held-out misfit is {m['handicap']:.2f} × the calibrated nominal's (median), so a model with "
-                      "more freedom can fit the held-out files better than the truth; the second row counts those."]
-    if s.get("times"):
-        lines += ["", "**Time per case** on one core, the other cores diagnosing other cases: writing the files "
-                  "(the reference simulations and sizing each withheld effect) and diagnosing them, and the "
-                  "diagnosis alone (what a user's costs)", "",
-                  "| cases | number | writing and diagnosing: median [s] | longest [s] | diagnosis alone: median [s] "
-                  "| longest [s] |", "|---|---|---|---|---|---|"]
-        lines += [f"| {t['kind']} | {t['cases']} | "
-                  + (f"{t['median_s']:.0f} | {t['longest_s']:.0f} | {t['diagnose_median_s']:.0f} | "
-                     f"{t['diagnose_longest_s']:.0f} |" if t["cases"] else "— | — | — | — |")
-                  for t in s["times"]]
-        if s.get("fits_reused"):
-            n = s["fits_reused"]
-            lines += ["", f"Left out: the {n} case{'' if n == 1 else 's'} diagnosed again from the fits an earlier "
-                      "run stored (their outcome removed)."]
+    if not (m and m["judged"]):
+        return []
+    lines = ["", "**Misses: the data or the search**: each miss's named model against the truth, both on the "
+             "held-out files (the truth: the FMU at the true parameters over the calibrated nominal's others)",
+             "", "| misses | cases |", "|---|---|",
+             f"| undetected: verdict 'no significant gap' (the nominal within the noise threshold) | "
+             f"{m['undetected']} |",
+             f"| the named model fits the held-out files at least as well as the truth (the data do not favour "
+             f"the truth) | {m['undecided']} |",
+             f"| the truth fits them better but would itself not be named (its held-out shrink of the gap "
+             f"below the least a named model needs, or its misfit above the explanation threshold) | "
+             f"{m['unnamed']} |",
+             f"| the truth fits them better and would be named (a miss of the search or of the selection) | "
+             f"{m['search']} |", "",
+             f"Top-1 accuracy on the {s['decided']} cases detected and decided by the data: "
+             f"{100 * s['top1_decided']:.0f} %."]
+    if m["handicap"] is not None:
+        lines += ["", f"The truth at its true parameters carries the sensor chain (anti-alias filter, decimation) "
+                  f"and the other simulator, which a calibration takes up: on the null cases its held-out misfit is "
+                  f"{m['handicap']:.2f} × the calibrated nominal's (median), so a model with more freedom can fit "
+                  "the held-out files better than the truth; the second row counts those."]
+    return lines
+
+
+def _time_lines(s: dict) -> list[str]:
+    """Time per case on one core, by kind (null cases, single effects, pairs)."""
+    if not s.get("times"):
+        return []
+    lines = ["", "**Time per case** on one core, the other cores diagnosing other cases: writing the files "
+             "(the reference simulations and sizing each withheld effect) and diagnosing them, and the "
+             "diagnosis alone (what a user's costs)", "",
+             "| cases | number | writing and diagnosing: median [s] | longest [s] | diagnosis alone: median [s] "
+             "| longest [s] |", "|---|---|---|---|---|---|"]
+    lines += [f"| {t['kind']} | {t['cases']} | "
+              + (f"{t['median_s']:.0f} | {t['longest_s']:.0f} | {t['diagnose_median_s']:.0f} | "
+                 f"{t['diagnose_longest_s']:.0f} |" if t["cases"] else "— | — | — | — |")
+              for t in s["times"]]
+    if s.get("fits_reused"):
+        n = s["fits_reused"]
+        lines += ["", f"Left out: the {n} case{'' if n == 1 else 's'} diagnosed again from the fits an earlier "
+                  "run stored (their outcome removed)."]
+    return lines
+
+
+def _calibration_lines(s: dict) -> list[str]:
+    """The hit rate by the named model's shrink (the calibration), and the stated confidence against it."""
     q = s["no_gap"]
-    lines += ["", "**Calibration**: when a report names an effect, how often it is right, by the named model's "
-              "held-out shrink (a single report states the rate of its row as its confidence)", "",
-              "| held-out shrink [%] | named | right |", "|---|---|---|"]
+    lines = ["", "**Calibration**: when a report names an effect, how often it is right, by the named model's "
+             "held-out shrink (a single report states the rate of its row as its confidence)", "",
+             "| held-out shrink [%] | named | right |", "|---|---|---|"]
     lines += [f"| {confidence.range_label(*b['shrink_pct'])} | {b['named']} | {_share(b['right'], b['named'])} |"
               for b in s["by_shrink"]]
     lines += [f"| verdict 'no significant gap' | {q['verdicts']} | {_share(q['right'], q['verdicts'])} |"]
     src = s.get("stated_from")
-    if src:
-        inside = " (the same cases: in-sample, not a check)" if src["seed"] == s["seed"] else ""
-        lines += ["", f"**Stated confidence against the hit rate**: the reports stated the confidence of the "
-                  f"calibration of `{src['source']}` ({src['cases']} cases){inside}", "",
-                  "| stated confidence | reports | mean stated | right |", "|---|---|---|---|"]
-        lines += [f"| {c['stated_pct']} % | {c['reports']} | "
-                  f"{'—' if c['mean_stated'] is None else format(100 * c['mean_stated'], '.0f') + ' %'} | "
-                  f"{_share(c['right'], c['reports'])} |" for c in s["check"]]
-    return "\n".join(lines) + "\n"
+    if not src:
+        return lines
+    inside = " (the same cases: in-sample, not a check)" if src["seed"] == s["seed"] else ""
+    lines += ["", f"**Stated confidence against the hit rate**: the reports stated the confidence of the "
+              f"calibration of `{src['source']}` ({src['cases']} cases){inside}", "",
+              "| stated confidence | reports | mean stated | right |", "|---|---|---|---|"]
+    lines += [f"| {c['stated_pct']} % | {c['reports']} | "
+              f"{'—' if c['mean_stated'] is None else format(100 * c['mean_stated'], '.0f') + ' %'} | "
+              f"{_share(c['right'], c['reports'])} |" for c in s["check"]]
+    return lines

@@ -33,21 +33,18 @@ def run_cases(root, out_dir, cfg: DiagnoseConfig | None = None, model: str = "sd
         test = impedance_test_in(case)
         if test:
             rep = diagnose_impedance(test, pathlib.Path(out_dir) / case.name, cfg, fmu_dir, nominal, workers=workers)
-            worst = max(rep["by_frequency"], key=lambda d: d["heldout_error"])["frequency_hz"]
-            gap, floor, band = rep["heldout_error_nominal"], rep["uncertainty"], [worst, worst]
         else:
             rep = diagnose(model, case, pathlib.Path(out_dir) / case.name, cfg, fmu_dir, workers, progress=False,
                            nominal=nominal)
-            gap, floor, band = rep["gap"]["overall"], rep["gap"]["noise_floor"], rep["gap"]["worst_band_hz"]
         truth = json.loads((case / "truth.json").read_text())["effect"] if (case / "truth.json").is_file() else None
-        expected = None if truth in (None, "none") else truth
-        top = rep["ranking"][0] if rep["ranking"] else None
-        rows.append({"case": case.name, "withheld": truth, "verdict": rep["verdict"],
-                     "correct": rep["chosen_effect"] == expected, "gap": gap, "noise_floor": floor,
-                     "worst_band_hz": band,
-                     "shrink_pct": top["shrink_pct"] if top and rep["chosen_effect"] else None,
-                     "runner_up": rep["ranking"][1]["effect"] if len(rep["ranking"]) > 1 else None,
-                     "runner_up_shrink_pct": rep["ranking"][1]["shrink_pct"] if len(rep["ranking"]) > 1 else None,
+        expected = () if truth in (None, "none") else tuple(sorted(truth.split("+")))
+        runner_up = rep.ranking[1] if len(rep.ranking) > 1 else None
+        rows.append({"case": case.name, "withheld": truth, "verdict": rep.sentence,
+                     "correct": tuple(sorted(rep.chosen)) == expected, "gap": rep.gap.overall,
+                     "noise_floor": rep.gap.noise_floor, "worst_band_hz": list(rep.gap.worst_band_hz),
+                     "shrink_pct": rep.best.shrink_pct if rep.chosen else None,
+                     "runner_up": runner_up.effect if runner_up else None,
+                     "runner_up_shrink_pct": runner_up.shrink_pct if runner_up else None,
                      "wall_s": time.perf_counter() - t0})
     write_summary(rows, out_dir)
     return rows

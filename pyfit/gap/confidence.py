@@ -20,11 +20,14 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from pyfit.gap.config import LAYOUT, settings_with_role
+from pyfit.gap.result import Verdict
+
 CALIBRATION = pathlib.Path(__file__).with_name("calibration.json")
 SHRINK_BINS = (-np.inf, 50.0, 80.0, 95.0, np.inf)  # the named model's held-out shrink [%]
 STATED_BINS = (0.0, 0.5, 0.8, 0.95, 1.0 + 1e-9)  # stated confidence, for the check against the hit rate
 # diagnosis settings that say which files are which and what is compared, not how a verdict is reached
-LAYOUT_SETTINGS = ("calibration", "bands_hz", "transient_s")
+LAYOUT_SETTINGS = settings_with_role(LAYOUT)
 
 
 @dataclass(frozen=True)
@@ -95,7 +98,7 @@ def calibration_of(outcomes: list[dict], source: str, seed: int, settings: dict 
         inside = [o for o in named if bin_of(o["top_shrink_pct"], SHRINK_BINS) == k]
         by_shrink.append({"shrink_pct": [SHRINK_BINS[k], SHRINK_BINS[k + 1]], "named": len(inside),
                           "right": sum(o["named"] == o["withheld"] for o in inside)})
-    quiet = [o for o in outcomes if o["verdict"] == "no significant gap"]
+    quiet = [o for o in outcomes if o["verdict"] == Verdict.NO_GAP.value]
     return {"source": source, "seed": seed, "cases": len(outcomes), "model": model, "settings": settings or {},
             "by_shrink": by_shrink,
             "no_gap": {"verdicts": len(quiet), "right": sum(o["withheld"] == "none" for o in quiet)}}
@@ -131,7 +134,7 @@ def stated(verdict: str, chosen: str | None, shrink_pct: float | None, calibrati
         row = calibration["by_shrink"][k]
         right, of = row["right"], row["named"]
         alike = f"that named an effect with a held-out shrink of {shrink_label(k)} %"
-    elif verdict == "no significant gap":
+    elif verdict == Verdict.NO_GAP.value:
         right, of = calibration["no_gap"]["right"], calibration["no_gap"]["verdicts"]
         alike = "with the verdict 'no significant gap' (right: nothing was withheld)"
     else:

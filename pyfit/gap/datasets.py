@@ -168,6 +168,55 @@ def _same_system(model: str, a: dict, b: dict) -> bool:
     return bool(np.array_equal(ref.param_vector(a), ref.param_vector(b)))
 
 
+def _level_signal(kind: str, family: Family, level: float, style: LabStyle, seed: int, periods: int):
+    """One level's excitation, the seconds simulated and the samples kept: a sweep, a stepped sine or band-limited
+    noise from rest over style.record_s, or `periods` periods of a random-odd multisine after the lead periods."""
+    (f0, f1), fs, spp = family.band_hz, family.fs, family.samples_per_period
+    stop, keep = style.record_s, slice(0, int(round(style.record_s * fs)))
+    if kind == "sweep":
+        signal = Excitation(2 if family.model == "SDOFBoucWen" else 4, level, f0, f1,
+                            (f1 - f0) / (style.record_s - 1.0), t_ramp=1.0)
+    elif kind == "stepped_sine":
+        clamp = dict(glide_s=GLIDE_S, velocity=True) if family.model != "SDOFBoucWen" else {}
+        signal = SteppedSine(tuple(np.geomspace(f0, f1, STEPS)), style.record_s / STEPS, level, **clamp)
+    elif kind == "noise":
+        signal = band_noise(f0, f1, level, seed)
+    else:
+        lead = family.lead_periods
+        signal = PeriodicSignal(multisine(spp, fs, f0, f1, level, seed, odd=True), fs)
+        stop, keep = (lead + periods + 1) * spp / fs, slice(lead * spp, (lead + periods) * spp)
+    return signal, stop, keep
+
+
+def _recorded_inputs(family: Family, kind: str, signal, t_in, motion: str) -> dict:
+    """The input channels as recorded at the times `t_in`: the SDOF's force, else the clamp's x, v, a of `motion`."""
+    if family.model == "SDOFBoucWen":
+        return {"u_meas": (signal(t_in), "N", "u")}
+    values = ({"x": signal(t_in), "v": signal.derivative(t_in, 1), "a": signal.derivative(t_in, 2)}
+              if kind == "multisine" else motion_with_derivatives(signal, t_in, ("x", "v", "a")))
+    return {f"{var}_meas": (values[k], u, var) for k, u, var in
+            (("x", "m", "x_base"), ("v", "m/s", "v_base"), ("a", "m/s2", "a_base")) if k in motion}
+
+
+def _change(exact: dict, clean: dict, keep: slice, recorded) -> dict:
+    """What an effect changes of a level's outputs against the truth without it: the RMS (RMS(y)/RMS(y_tangent) -
+    1) and the output itself (RMS(y - y_tangent)/RMS(y_tangent)), over every recorded output."""
+    num = sum(np.mean((exact[o][keep] - clean[o][keep]) ** 2) for o in recorded)
+    den = sum(np.mean(clean[o][keep] ** 2) for o in recorded)
+    rms = sum(np.mean(exact[o][keep] ** 2) for o in recorded)
+    return {"rms": float(np.sqrt(rms / den) - 1.0), "output": float(np.sqrt(num / den))}
+
+
+def _check_request(family: Family, effect: str, style: LabStyle, truth: dict | None) -> None:
+    if truth is None and any(e not in family.withheld for e in effect.split("+")):
+        raise ValueError(f"effect '{effect}' unknown for {family.model}; allowed: {', '.join(family.withheld)} "
+                         "(or several joined by '+', or the truth's parameters given)")
+    allowed = excitations(family)
+    if style.excitation not in allowed:
+        raise ValueError(f"excitation '{style.excitation}' unknown for {family.model}; allowed: "
+                         f"{', '.join(allowed)}")
+
+
 def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: int = PERIODS,
                   style: LabStyle = LabStyle(), base: dict | None = None, truth: dict | None = None) -> pathlib.Path:
     """Write one dataset (a file per level) whose truth has `effect` ('none' for a null case), as recorded in
@@ -179,75 +228,46 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     noise, the squares averaged over every level and output: how far the data show it beside the others, before
     any model takes up part of it; only the effects `family.tangent` switches off, not a channel delay or a mass
     offset); the diagnosis never reads it."""
-    if truth is None and any(e not in family.withheld for e in effect.split("+")):
-        raise ValueError(f"effect '{effect}' unknown for {family.model}; allowed: {', '.join(family.withheld)} "
-                         "(or several joined by '+', or the truth's parameters given)")
-    allowed = excitations(family)
-    if style.excitation not in allowed:
-        raise ValueError(f"excitation '{style.excitation}' unknown for {family.model}; allowed: "
-                         f"{', '.join(allowed)}")
+    _check_request(family, effect, style, truth)
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     truth = _truth_params(family, effect, base or {}, truth)
     recorded = tuple(style.outputs or family.outputs)
-    spp, fs, lead = family.samples_per_period, family.fs, family.lead_periods
     rng = np.random.default_rng(seed)
     changes = {}
     members = {e: {k: v for k, v in family.tangent.items() if k in family.withheld.get(e, {})}
                for e in effect.split("+") if e != "none"}
     member_sq, channels = {e: 0.0 for e, off in members.items() if off}, 0  # of the records' outputs
-    kind, (f0, f1) = style.excitation, family.band_hz
+    kind = style.excitation
     amplitude = kind in ("sweep", "stepped_sine")  # levels are amplitudes (else RMS values)
     levels, unit = SWEEP_LEVELS[family.model] if amplitude else (family.levels, family.level_unit)
+    physical = {k: v for k, v in truth.items() if k != "sensor_delay"}  # the delay is in the recording
+
+    def simulated(signal, stop, params):
+        return _truth(SyntheticSpec(family.model, signal, stop, family.fs, list(recorded), params,
+                                    oversample=OVERSAMPLE, rtol=TRUTH_RTOL, atol=TRUTH_ATOL))
+
     for i, level in enumerate(levels):
-        stop, keep = style.record_s, slice(0, int(round(style.record_s * fs)))
-        if kind == "sweep":
-            signal = Excitation(2 if family.model == "SDOFBoucWen" else 4, level, f0, f1,
-                                (f1 - f0) / (style.record_s - 1.0), t_ramp=1.0)
-        elif kind == "stepped_sine":
-            clamp = dict(glide_s=GLIDE_S, velocity=True) if family.model != "SDOFBoucWen" else {}
-            signal = SteppedSine(tuple(np.geomspace(f0, f1, STEPS)), style.record_s / STEPS, level, **clamp)
-        elif kind == "noise":
-            signal = band_noise(f0, f1, level, seed)
-        else:
-            signal = PeriodicSignal(multisine(spp, fs, f0, f1, level, seed, odd=True), fs)
-            stop, keep = (lead + periods + 1) * spp / fs, slice(lead * spp, (lead + periods) * spp)
-        physical = {k: v for k, v in truth.items() if k != "sensor_delay"}  # the delay is in the recording
-        t, exact, _ = _truth(SyntheticSpec(family.model, signal, stop, fs, list(recorded), physical,
-                                           oversample=OVERSAMPLE, rtol=TRUTH_RTOL, atol=TRUTH_ATOL))
+        signal, stop, keep = _level_signal(kind, family, level, style, seed, periods)
+        t, exact, _ = simulated(signal, stop, physical)
         tangent = {**physical, **family.tangent}
-        clean = exact if _same_system(family.model, tangent, physical) else _truth(SyntheticSpec(
-            family.model, signal, stop, fs, list(recorded), tangent, oversample=OVERSAMPLE, rtol=TRUTH_RTOL,
-            atol=TRUTH_ATOL))[1]
+        clean = exact if _same_system(family.model, tangent, physical) else simulated(signal, stop, tangent)[1]
         tk = t[keep] - t[keep][0]
         sigma = {o: _noise_of(family, o, clean[o][keep]) for o in recorded}
         channels += len(recorded)
         for e in member_sq:  # the truth with this member off, the others on (one member: the tangent truth)
-            off = clean if len(members) == 1 else _truth(SyntheticSpec(
-                family.model, signal, stop, fs, list(recorded), {**physical, **members[e]}, oversample=OVERSAMPLE,
-                rtol=TRUTH_RTOL, atol=TRUTH_ATOL))[1]
+            off = clean if len(members) == 1 else simulated(signal, stop, {**physical, **members[e]})[1]
             member_sq[e] += sum(np.mean((exact[o][keep] - off[o][keep]) ** 2) / sigma[o] ** 2 for o in recorded)
-        num = sum(np.mean((exact[o][keep] - clean[o][keep]) ** 2) for o in recorded)
-        den = sum(np.mean(clean[o][keep] ** 2) for o in recorded)
-        rms = sum(np.mean(exact[o][keep] ** 2) for o in recorded)
-        key = f"{level:g}"
-        changes[key] = {"rms": float(np.sqrt(rms / den) - 1.0), "output": float(np.sqrt(num / den))}
+        changes[f"{level:g}"] = _change(exact, clean, keep, recorded)
         # a skew between the channels: the input channel records the signal `sensor_delay` seconds early
-        t_in = t[keep] + truth.get("sensor_delay", 0.0)
-        if family.model == "SDOFBoucWen":
-            inputs = {"u_meas": (signal(t_in), "N", "u")}
-        else:
-            motion = ({"x": signal(t_in), "v": signal.derivative(t_in, 1), "a": signal.derivative(t_in, 2)}
-                      if kind == "multisine" else motion_with_derivatives(signal, t_in, ("x", "v", "a")))
-            inputs = {f"{var}_meas": (motion[k], u, var) for k, u, var in
-                      (("x", "m", "x_base"), ("v", "m/s", "v_base"), ("a", "m/s2", "a_base")) if k in style.motion}
+        inputs = _recorded_inputs(family, kind, signal, t[keep] + truth.get("sensor_delay", 0.0), style.motion)
         outputs = {f"{o}_meas": (exact[o][keep] + rng.normal(0.0, sigma[o], len(tk)),
                                  UNITS.get(o, "m"), o) for o in recorded}
         shown = level * 1e3 if unit == "mm" else level
-        name = f"level{i + 1}_{shown:g}{unit.replace('/', '')}.csv"
-        write_measurement(out / name, family.model, tk, inputs, outputs,
-                          level=f"{'amplitude' if amplitude else 'RMS'} {shown:g} {unit}", level_value=shown,
-                          excitation=_excitation_meta(kind, signal, family, level, spp, periods),
+        write_measurement(out / f"level{i + 1}_{shown:g}{unit.replace('/', '')}.csv", family.model, tk, inputs,
+                          outputs, level=f"{'amplitude' if amplitude else 'RMS'} {shown:g} {unit}", level_value=shown,
+                          excitation=_excitation_meta(kind, signal, family, level, family.samples_per_period,
+                                                      periods),
                           notes=f"synthetic: CasADi reference (cvodes) at 10x the sensor rate, zero-phase FIR "
                                 f"anti-alias + decimation, noise {family.noise} m (or its equivalent), seed {seed}")
     (out / "truth.json").write_text(json.dumps({"effect": effect, "params": truth, "seed": seed,

@@ -21,8 +21,9 @@ import numpy as np
 from pyfit.fit.impedance_objective import model_impedance, relative_residuals
 from pyfit.fit.optim.baselines import polish
 from pyfit.gap.attribute import STIFFNESS_SCAN, UnitScaling, effect_start
-from pyfit.gap import selection
+from pyfit.gap import judge, selection
 from pyfit.gap.diagnose import DiagnoseConfig, DiagnoseError, fmu_defaults
+from pyfit.gap.result import BandMisfit, Diagnosis, Gap, LevelMisfit, ModelFit, NominalFit, Verdict
 from pyfit.gap.systems import Scale, damper_stiffness, damper_stuck_force, make_system
 from pyfit.io.impedance import ImpedanceTest, read_impedance
 from pyfit.io.nominal import NominalModel, load_nominal
@@ -141,24 +142,19 @@ def _strength_starts(effect, scale: Scale) -> list[dict]:
     return starts
 
 
-def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu_dir="fmus",
-                       nominal: NominalModel | str | None = None, uncertainty: float | None = None,
-                       workers: int | None = None) -> dict:
-    """Diagnose a damper's impedance test against the nominal damper (a NominalModel or TOML file; None: the
-    theory §1.3 damper); `uncertainty`: the test's relative measurement error (RMS of |Z_meas / Z_true − 1|;
-    None: the value its sidecar states). The effects are refitted in parallel on `workers` processes (None:
-    one per core); finished fits are kept in OUT/fits/ (a rerun with the same OUT redoes only the unfinished
-    ones). Writes OUT/report.json, OUT/report.md and the impedance figures; returns the report."""
-    cfg = cfg or DiagnoseConfig()
+def _read_test(csv_path, uncertainty: float | None) -> tuple[ImpedanceTest, float]:
+    """The impedance test and its relative measurement uncertainty (`uncertainty`, else its sidecar's)."""
     test = read_impedance(csv_path)
     uncertainty = test.uncertainty if uncertainty is None else uncertainty
     if uncertainty is None or not 0 < uncertainty < 1:
         raise DiagnoseError(f"{test.path}: the test's measurement uncertainty is {uncertainty}; an impedance table "
                             "carries no noise to estimate it from: state it (`uncertainty` in the sidecar or "
                             "--uncertainty), the relative error, 0 < uncertainty < 1")
-    cal_cols, held_cols = split_levels(test)
-    cal, held = levels_of(test, cal_cols), levels_of(test, held_cols)
-    fmu = str(ensure_fmu("DamperElement", pathlib.Path(fmu_dir)))
+    return test, uncertainty
+
+
+def _damper(fmu: str, nominal, cfg: DiagnoseConfig):
+    """The damper system (with the user's description), the FMU's defaults and the description."""
     runner = FmuRunner(fmu)
     described = load_nominal(nominal) if isinstance(nominal, (str, pathlib.Path)) else nominal
     if described is not None:
@@ -167,126 +163,172 @@ def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu
                                 "of a damper")
         described.check_against(runner.parameters())
     defaults = fmu_defaults(runner)
-    system = make_system("damper", defaults, described)
     runner.close()
+    system = make_system("damper", defaults, described)
     unknown = [e for e in (cfg.effects or []) if e not in system.effects]
     if unknown:
         raise DiagnoseError(f"effects: '{unknown[0]}' unknown for the damper; allowed: {', '.join(system.effects)}")
+    return system, defaults, described
 
-    def judged(name, params, free, n_added, evaluations) -> ImpedanceFit:
+
+@dataclass(frozen=True)
+class ImpedanceRun:
+    """One impedance diagnosis's inputs: the FMU, the test, its calibration and held-out levels, the system, the
+    settings, where fits are stored (OUT/fits) and their key, the workers."""
+
+    fmu: str
+    test: ImpedanceTest
+    cal: ImpedanceTest
+    held: ImpedanceTest
+    system: object
+    cfg: DiagnoseConfig
+    fits_dir: pathlib.Path
+    key: str
+    workers: int | None
+
+    def judged(self, name, params, free, n_added, evaluations) -> ImpedanceFit:
+        """A fit's errors on the calibration and held-out levels."""
         return ImpedanceFit(name, {k: float(v) for k, v in params.items()}, free, n_added,
-                            relative_error(model_impedance(fmu, cal, params), cal),
-                            relative_error(model_impedance(fmu, held, params), held), evaluations)
+                            relative_error(model_impedance(self.fmu, self.cal, params), self.cal),
+                            relative_error(model_impedance(self.fmu, self.held, params), self.held), evaluations)
 
+
+def _nominal(r: ImpedanceRun) -> ImpedanceFit:
+    """The nominal damper calibrated on the calibration levels (from its start and the stiffness scan)."""
+    system = r.system
     start = system.start([])
     starts = [start] + [{**start, system.stiffness: start[system.stiffness] * f} for f in STIFFNESS_SCAN if f != 1]
     bounds = {n: (min(system.bounds(s)[n][0] for s in starts), max(system.bounds(s)[n][1] for s in starts))
               for n in start}
+    path = r.fits_dir / "nominal.json"
+    params, n_eval = _stored(path, r.key) or _fit_and_store(
+        ((r.fmu, r.cal, dict(system.nominal_fixed), starts, bounds, (), r.cfg.nominal_budget), path, r.key))
+    return r.judged("nominal", params, list(start), 0, n_eval)
+
+
+def _effect_fits(r: ImpedanceRun, nominal: ImpedanceFit, defaults: dict) -> dict[str, ImpedanceFit]:
+    """Each candidate effect refitted on the calibration levels (an impedance table carries no time signals:
+    effects on the recorded channels do not apply)."""
+    system, fits, free, jobs = r.system, {}, {}, []
+    scale = deflection_scale(r.fmu, r.cal, {**defaults, **nominal.params})
+    for name in r.cfg.effects or [n for n, e in system.effects.items() if not e.signal_only]:
+        effect, path = system.effects[name], r.fits_dir / f"{name}.json"
+        e_start, e_bounds, e_fixed = effect_start(system, effect, scale, nominal.params)
+        free[name], kept = list(e_start), _stored(path, r.key)
+        if kept:
+            fits[name] = r.judged(name, kept[0], free[name], effect.strengths, kept[1])
+            continue
+        tries = [{**e_start, **s} for s in _strength_starts(effect, scale) + effect.starts(scale)]
+        jobs.append(((r.fmu, r.cal, {**system.nominal_fixed, **e_fixed}, tries, e_bounds,
+                      tuple(p.name for p in effect.params if p.log), r.cfg.refit_budget), path, r.key))
+    for job, (params, n_eval) in zip(jobs, map_tasks(_fit_and_store, jobs, r.workers, progress=False)):
+        name = job[1].stem
+        fits[name] = r.judged(name, params, free[name], system.effects[name].strengths, n_eval)
+    return fits
+
+
+def _ranking(fits: dict, before: float, reference: float, explained_below: float, cfg) -> list[ModelFit]:
+    """The refitted effects by score: the shrink of the held-out misfit less 5 points per added strength."""
+    ranking = []
+    for name, fit in fits.items():
+        shrink = selection.shrink_pct(before, fit.heldout_error, reference)
+        ranking.append(ModelFit(
+            name, (name,), selection.score(before, fit.heldout_error, reference, fit.n_added), before,
+            fit.heldout_error, shrink, {n: fit.params[n] for n in fit.free}, fit.n_added, fit.calibration_error,
+            fit.evaluations, selection.explains(shrink, fit.heldout_error, explained_below, cfg.min_shrink_pct)))
+    return sorted(ranking, key=lambda d: -d.score)
+
+
+def _impedance_gap(r: ImpedanceRun, z_nom: np.ndarray, cal_cols, held_cols, floor: float, before: float,
+                   reference: float) -> Gap:
+    """Where the nominal misfits: by frequency on the held-out levels and by level (relative errors)."""
+    test, cfg = r.test, r.cfg
+    error = np.abs(z_nom / test.impedance - 1) ** 2
+    by_frequency = np.sqrt(np.mean(error[:, held_cols], axis=1))
+    velocity = (2 * np.pi * test.frequencies[:, None] * test.amplitudes).mean(axis=0)
+    worst = float(test.frequencies[int(np.argmax(by_frequency))])
+    return Gap(
+        overall=before, noise_floor=floor, noise_floor_scaled=floor, noise_floor_method=("stated uncertainty",),
+        significant=bool(selection.significant(before, floor, cfg.noise_factor, cfg.min_gap)),
+        worst_band_hz=(worst, worst),
+        by_band=tuple(BandMisfit((float(f), float(f)), float(e)) for f, e in zip(test.frequencies, by_frequency)),
+        by_level=tuple(LevelMisfit(test.path.stem, f"{velocity[j] * 1e3:.3g} mm/s", float(velocity[j]),
+                                   j in held_cols, float(np.sqrt(np.mean(error[:, j]))), floor)
+                       for j in sorted(cal_cols + held_cols, key=lambda j: velocity[j])),
+        shrink_reference=reference, metric="relative impedance error")
+
+
+def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu_dir="fmus",
+                       nominal: NominalModel | str | None = None, uncertainty: float | None = None,
+                       workers: int | None = None) -> Diagnosis:
+    """Diagnose a damper's impedance test against the nominal damper (a NominalModel or TOML file; None: the
+    FMU's damper); `uncertainty`: the test's relative measurement error (RMS of |Z_meas / Z_true − 1|; None: the
+    value its sidecar states). The effects are refitted on `workers` processes (None: one per core); finished
+    fits are kept in OUT/fits/. Writes OUT/report.json, OUT/report.md and the impedance figures."""
+    cfg = cfg or DiagnoseConfig()
+    test, floor = _read_test(csv_path, uncertainty)
+    cal_cols, held_cols = split_levels(test)
+    fmu = str(ensure_fmu("DamperElement", pathlib.Path(fmu_dir)))
+    system, defaults, described = _damper(fmu, nominal, cfg)
     out = pathlib.Path(out_dir)
     (out / "fits").mkdir(parents=True, exist_ok=True)
     description = ({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}
                    if described else {})
     key = hashlib.sha256(test.path.read_bytes() + test.path.with_suffix(".toml").read_bytes() + json.dumps(
         [cfg.nominal_budget, cfg.refit_budget, description], sort_keys=True).encode()).hexdigest()[:16]
-    nominal_path = out / "fits" / "nominal.json"
-    params, n_eval = _stored(nominal_path, key) or _fit_and_store(
-        ((fmu, cal, dict(system.nominal_fixed), starts, bounds, (), cfg.nominal_budget), nominal_path, key))
-    nominal_fit = judged("nominal", params, list(start), 0, n_eval)
-    floor, gap = uncertainty, nominal_fit.heldout_error
-    significant = gap > max(cfg.noise_factor * floor, floor + cfg.min_gap)
+    r = ImpedanceRun(fmu, test, levels_of(test, cal_cols), levels_of(test, held_cols), system, cfg, out / "fits",
+                     key, workers)
+    nominal_fit = _nominal(r)
+    before = nominal_fit.heldout_error
+    significant = selection.significant(before, floor, cfg.noise_factor, cfg.min_gap)
     nominal_fits = nominal_fit.calibration_error <= cfg.nominal_max_nrmse
-    fits = {}
-    if significant and nominal_fits:
-        scale = deflection_scale(fmu, cal, {**defaults, **nominal_fit.params})
-        free, jobs = {}, []
-        # an impedance table carries no time signals: effects on the recorded channels do not apply
-        for name in cfg.effects or [n for n, e in system.effects.items() if not e.signal_only]:
-            effect, path = system.effects[name], out / "fits" / f"{name}.json"
-            e_start, e_bounds, e_fixed = effect_start(system, effect, scale, nominal_fit.params)
-            free[name], stored = list(e_start), _stored(path, key)
-            if stored:
-                fits[name] = judged(name, stored[0], free[name], effect.strengths, stored[1])
-                continue
-            tries = [{**e_start, **s} for s in _strength_starts(effect, scale) + effect.starts(scale)]
-            jobs.append(((fmu, cal, {**system.nominal_fixed, **e_fixed}, tries, e_bounds,
-                          tuple(p.name for p in effect.params if p.log), cfg.refit_budget), path, key))
-        for job, (params, n_eval) in zip(jobs, map_tasks(_fit_and_store, jobs, workers, progress=False)):
-            name = job[1].stem
-            fits[name] = judged(name, params, free[name], system.effects[name].strengths, n_eval)
-    ranking = []
-    # the reference of the shrink: the stated uncertainty, or the best held-out misfit if smaller
+    fits = _effect_fits(r, nominal_fit, defaults) if significant and nominal_fits else {}
     reference = min([floor] + [fit.heldout_error for fit in fits.values()])
-    for name, fit in fits.items():
-        shrink = 100.0 * (gap - fit.heldout_error) / (gap - reference) if gap > reference else 0.0
-        explains = (shrink >= cfg.min_shrink_pct
-                    and fit.heldout_error <= selection.explained_below(floor, cfg.explain_factor,
-                                                                      cfg.explain_margin))
-        ranking.append({"effect": name, "score": shrink - 5.0 * (fit.n_added - 1), "shrink_pct": shrink,
-                        "heldout_error_after": fit.heldout_error, "calibration_error": fit.calibration_error,
-                        "explains": bool(explains), "n_added_params": fit.n_added,
-                        "params": {n: fit.params[n] for n in fit.free}, "evaluations": fit.evaluations})
-    ranking.sort(key=lambda d: -d["score"])
-    if not nominal_fits:
-        verdict = "nominal model does not fit"
-    elif not significant:
-        verdict = "no significant gap"
-    elif ranking and ranking[0]["explains"]:
-        verdict = f"gap explained by {ranking[0]['effect']}"
-    else:
-        verdict = "gap not explained by the candidate effects"
+    explained_below = selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin)
     z_nom = model_impedance(fmu, test, nominal_fit.params)
-    by_frequency = np.sqrt(np.mean(np.abs(z_nom[:, held_cols] / test.impedance[:, held_cols] - 1) ** 2, axis=1))
-    velocity = 2 * np.pi * test.frequencies[:, None] * test.amplitudes
-    result = {"test": str(test.path), "verdict": verdict,
-              "chosen_effect": ranking[0]["effect"] if verdict.startswith("gap explained") else None,
-              "uncertainty": floor, "shrink_reference": reference, "heldout_error_nominal": gap,
-              "significant": bool(significant),
-              "calibration_levels_m_s": [float(velocity[:, j].mean()) for j in cal_cols],
-              "heldout_levels_m_s": [float(velocity[:, j].mean()) for j in held_cols],
-              "nominal": asdict(nominal_fit),
-              "by_frequency": [{"frequency_hz": float(f), "heldout_error": float(e)}
-                               for f, e in zip(test.frequencies, by_frequency)],
-              "ranking": ranking}
+    gap = _impedance_gap(r, z_nom, cal_cols, held_cols, floor, before, reference)
+    ranking = _ranking(fits, before, reference, explained_below, cfg)
+    verdict = judge.verdict(gap, ranking[0] if ranking else None, nominal_fits)
+    d = Diagnosis("damper", fmu, str(test.path), verdict, (ranking[0].effect,) if verdict is Verdict.EXPLAINED else (),
+                  explained_below, gap, tuple(ranking), (),
+                  NominalFit({n: nominal_fit.params[n] for n in nominal_fit.free}, nominal_fit.calibration_error,
+                             nominal_fit.evaluations),
+                  tuple(v.level for v in gap.by_level if not v.held_out),
+                  tuple(v.level for v in gap.by_level if v.held_out))
     models = {"nominal": z_nom}
     if ranking:
-        best = ranking[0]["effect"]
-        models[f"with {best}"] = model_impedance(fmu, test, fits[best].params)
+        models[f"with {ranking[0].effect}"] = model_impedance(fmu, test, fits[ranking[0].effect].params)
     plots.impedance_curves(out, test, models, test.path.stem)
-    (out / "report.json").write_text(json.dumps(result, indent=1))
-    (out / "report.md").write_text(report_markdown(result, cfg))
-    return result
+    (out / "report.json").write_text(json.dumps(d.to_json(), indent=1))
+    (out / "report.md").write_text(report_markdown(d, cfg))
+    return d
 
 
-def report_markdown(rep: dict, cfg: DiagnoseConfig) -> str:
+def report_markdown(d: Diagnosis, cfg: DiagnoseConfig) -> str:
     """The report of diagnose_impedance as Markdown."""
-    floor = rep["uncertainty"]
-
-    def mm_s(levels):
-        return ", ".join(f"{v * 1e3:.3g}" for v in levels)
-
-    lines = [f"# Gap diagnosis on an impedance test: {pathlib.Path(rep['test']).name}", "",
-             f"**Verdict: {rep['verdict']}.**", "",
-             f"Calibrated on the clamp-velocity levels {mm_s(rep['calibration_levels_m_s'])} mm/s; held out: "
-             f"{mm_s(rep['heldout_levels_m_s'])} mm/s.", "",
+    g, floor = d.gap, d.gap.noise_floor
+    lines = [f"# Gap diagnosis on an impedance test: {pathlib.Path(d.source).name}", "",
+             f"**Verdict: {d.sentence}.**", "",
+             f"Calibrated on the clamp-velocity levels {', '.join(d.calibration_files)}; held out: "
+             f"{', '.join(d.held_out_files)}.", "",
              "Held-out misfit of the nominal damper (RMS of |Z_model/Z_meas − 1|): "
-             f"**{rep['heldout_error_nominal']:.4f}**; calibration misfit {rep['nominal']['calibration_error']:.4f}; "
+             f"**{g.overall:.4f}**; calibration misfit {d.nominal.calibration_nrmse:.4f}; "
              f"the test's stated uncertainty {floor:.4f}. A gap counts above "
-             f"{max(cfg.noise_factor * floor, floor + cfg.min_gap):.4f}; an effect explains it when its held-out "
-             f"misfit is at most {selection.explained_below(floor, cfg.explain_factor, cfg.explain_margin):.4f} "
-             "and it removes "
-             f"at least {cfg.min_shrink_pct:.0f} % of the gap.", "",
-             "Nominal: " + ", ".join(f"{n} = {rep['nominal']['params'][n]:.4g}" for n in rep["nominal"]["free"]), "",
+             f"{selection.noise_level(floor, cfg.noise_factor, cfg.min_gap):.4f}; an effect explains it when its "
+             f"held-out misfit is at most {d.explained_below:.4f} and it removes at least {cfg.min_shrink_pct:.0f} % "
+             "of the gap.", "",
+             "Nominal: " + ", ".join(f"{n} = {v:.4g}" for n, v in d.nominal.params.items()), "",
              "## Where", "", "| frequency [Hz] | nominal held-out misfit |", "|---|---|"]
-    lines += [f"| {d['frequency_hz']:g} | {d['heldout_error']:.4f} |" for d in rep["by_frequency"]]
-    if rep["ranking"]:
+    lines += [f"| {b.band_hz[0]:g} | {b.nrmse:.4f} |" for b in g.by_band]
+    if d.ranking:
         lines += ["", "## Which effect", "", "| effect | score | held-out misfit after | shrink [%] | added params | "
                   "fitted |", "|---|---|---|---|---|---|"]
-        for r in rep["ranking"]:
-            params = ", ".join(f"{k} = {v:.4g}" for k, v in r["params"].items())
-            lines.append(f"| {r['effect']} | {r['score']:.1f} | {r['heldout_error_after']:.4f} | "
-                         f"{r['shrink_pct']:.1f} | {r['n_added_params']} | {params} |")
+        for r in d.ranking:
+            params = ", ".join(f"{k} = {v:.4g}" for k, v in r.params.items())
+            lines.append(f"| {r.effect} | {r.score:.1f} | {r.heldout_gap_after:.4f} | {r.shrink_pct:.1f} | "
+                         f"{r.n_added_params} | {params} |")
         lines += ["", "Score = shrink − 5 points per added parameter beyond the first; shrink = (misfit before − "
-                  f"after) / (misfit before − reference), reference {rep['shrink_reference']:.4f} = the smaller of "
+                  f"after) / (misfit before − reference), reference {g.shrink_reference:.4f} = the smaller of "
                   "the uncertainty and the best misfit after."]
     lines += ["", "![|Z|](impedance_abs.png)", "", "![phase](impedance_phase.png)"]
     return "\n".join(lines) + "\n"

@@ -53,18 +53,7 @@ class SweepConfig:
     title: str = ""
 
 
-def load_sweep(path: str | pathlib.Path, fmu_variables=None, nominal=None) -> SweepConfig:
-    """Read and validate a sweep study file.
-
-    nominal: a described system (pyfit.io.nominal.NominalModel): its parameters apply to every run, under
-    the study's own [parameters] and parameter sets.
-
-    fmu_variables(model) -> an object with .parameters (names that can be set), .variables (all names)
-    and .outputs (the FMU's outputs, the default); used to reject unknown names.
-    """
-    path = pathlib.Path(path)
-    doc = read_toml(path, ConfigError)
-    check_sections(doc, path, ("study", "excitation", "parameters", "parameter_sets"), ("study", "excitation"))
+def _study(doc, path) -> dict:
     st = check_table(doc["study"], path, "study", {
         "models": ("strings", True, None), "stop_time": (float, True, None), "output_interval": (float, False, 1e-3),
         "outputs": ("strings", False, None), "tolerance": (float, False, 1e-8), "title": (str, False, "")})
@@ -75,6 +64,10 @@ def load_sweep(path: str | pathlib.Path, fmu_variables=None, nominal=None) -> Sw
         fail(path, "study.stop_time", "stop_time and output_interval must be > 0 with output_interval <= stop_time")
     if abs(round(st["stop_time"] / st["output_interval"]) * st["output_interval"] - st["stop_time"]) > 1e-9:
         fail(path, "study.output_interval", "stop_time must be a whole number of output intervals")
+    return st
+
+
+def _excitation(doc, path) -> ExcitationConfig:
     ex = check_table(doc["excitation"], path, "excitation", {
         "kind": (str, True, None), "levels": ("floats", True, None), "frequencies": ("floats", False, []),
         "f_start": (float, False, 0.0), "f_end": (float, False, 60.0), "rate": (float, False, 0.5),
@@ -89,17 +82,23 @@ def load_sweep(path: str | pathlib.Path, fmu_variables=None, nominal=None) -> Sw
         fail(path, "excitation.f_end", "a sweep needs f_end > f_start and rate > 0")
     if ex["kind"] in ("log_sweep", "cv_linear_sweep", "cv_log_sweep") and ex["f_start"] <= 0:
         fail(path, "excitation.f_start", "log and constant-velocity sweeps need f_start > 0")
-    excitation = ExcitationConfig(**ex)
-    parameters = {**(nominal.parameters() if nominal else {}),
-                  **check_numbers(doc.get("parameters", {}), path, "parameters")}
+    return ExcitationConfig(**ex)
+
+
+def _parameter_sets(doc, path) -> list[ParameterSet]:
     sets = []
     for i, s in enumerate(doc.get("parameter_sets", [{"name": "default"}])):
         if "name" not in s or not isinstance(s["name"], str):
             fail(path, f"parameter_sets[{i}].name", "missing (a string)")
         sets.append(ParameterSet(s["name"], check_numbers({k: v for k, v in s.items() if k != "name"}, path,
-                                                     f"parameter_sets[{i}]")))
+                                                         f"parameter_sets[{i}]")))
     if len({s.name for s in sets}) != len(sets):
         fail(path, "parameter_sets", "names must be unique")
+    return sets
+
+
+def _outputs(st: dict, path, parameters: dict, sets: list, fmu_variables) -> dict:
+    """Each model's outputs (the study's, else every output of the FMU), its names checked against the FMU."""
     outputs = {}
     for m in st["models"]:
         outputs[m] = st["outputs"] or []
@@ -113,6 +112,26 @@ def load_sweep(path: str | pathlib.Path, fmu_variables=None, nominal=None) -> Sw
             if o not in iface.variables:
                 fail(path, "study.outputs", f"model {m} has no variable '{o}'", ", ".join(iface.outputs))
         outputs[m] = outputs[m] or list(iface.outputs)
+    return outputs
+
+
+def load_sweep(path: str | pathlib.Path, fmu_variables=None, nominal=None) -> SweepConfig:
+    """Read and validate a sweep study file.
+
+    nominal: a described system (pyfit.io.nominal.NominalModel): its parameters apply to every run, under
+    the study's own [parameters] and parameter sets.
+
+    fmu_variables(model) -> an object with .parameters (names that can be set), .variables (all names)
+    and .outputs (the FMU's outputs, the default); used to reject unknown names.
+    """
+    path = pathlib.Path(path)
+    doc = read_toml(path, ConfigError)
+    check_sections(doc, path, ("study", "excitation", "parameters", "parameter_sets"), ("study", "excitation"))
+    st = _study(doc, path)
+    excitation = _excitation(doc, path)
+    parameters = {**(nominal.parameters() if nominal else {}),
+                  **check_numbers(doc.get("parameters", {}), path, "parameters")}
+    sets = _parameter_sets(doc, path)
+    outputs = _outputs(st, path, parameters, sets, fmu_variables)
     return SweepConfig(path, st["models"], st["stop_time"], st["output_interval"], outputs, excitation, parameters,
                        sets, st["tolerance"], st["title"])
-

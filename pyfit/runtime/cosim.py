@@ -80,6 +80,80 @@ class _Vars:
         self.fmu.fmi2SetRealInputDerivatives(self.comp, self.vr, self.n, self.order, self.buf)
 
 
+def _check_request(scheme: str, extrapolation: str, stop_time: float, step: float) -> int:
+    """The number of communication steps; ValueError on an unknown scheme or extrapolation, or a stop time that is
+    not a whole number of steps."""
+    if scheme not in SCHEMES:
+        raise ValueError(f"scheme '{scheme}' unknown; allowed: {', '.join(SCHEMES)}")
+    if extrapolation not in EXTRAPOLATIONS:
+        raise ValueError(f"extrapolation '{extrapolation}' unknown; allowed: {', '.join(EXTRAPOLATIONS)}")
+    n = int(round(stop_time / step))
+    if n < 1 or abs(n * step - stop_time) > 1e-9 * max(stop_time, 1.0):
+        raise ValueError(f"stop_time {stop_time} s is not a whole number of communication steps {step} s")
+    return n
+
+
+class _Coupling:
+    """The FMUs coupled: each one's reads (every output a connection or the record needs, in one call), writes
+    (its connected inputs), the connections into it and whether it interpolates its inputs."""
+
+    def __init__(self, runners: dict, conns: list, rec: list):
+        needed = [src for src, _, _ in conns] + [d for _, _, d in conns if d] + rec
+        self.runners = runners
+        self.reads = {name: _Vars(r, sorted({v for f, v in needed if f == name})) for name, r in runners.items()}
+        self.inputs_of = {name: [(s, d) for s, t, d in conns if t[0] == name] for name in runners}
+        self.writes = {name: _Vars(r, [t[1] for _, t, _ in conns if t[0] == name]) for name, r in runners.items()}
+        self.interpolates = {name: bool(r.model_description.coSimulation.canInterpolateInputs)
+                             for name, r in runners.items()}
+
+    def now(self) -> dict:
+        return {name: self.reads[name].get() for name in self.runners}
+
+    def initialise(self) -> dict:
+        """Two fixed-point sweeps over the connections (direct feedthrough at t = 0), then out of initialisation;
+        returns every FMU's reads."""
+        now = self.now()
+        for _ in range(2):
+            for name in self.runners:
+                if self.inputs_of[name]:
+                    self.writes[name].set([now[s[0]][s[1]] for s, _ in self.inputs_of[name]])
+            now = self.now()
+        for name in self.runners:
+            self.runners[name].instance().exitInitializationMode()
+        return self.now()
+
+    def inputs(self, name, k, now, prev, new, step, scheme, extrapolation) -> tuple[list, list]:
+        """The values and slopes of FMU `name`'s inputs for step k: a source already stepped (Gauss-Seidel)
+        interpolated between t and t + h (or its newest value held), else extrapolated from t."""
+        values, slopes = [], []
+        for (sf, sv), d in self.inputs_of[name]:
+            if scheme == "gauss-seidel" and sf in new:
+                linear = extrapolation == "linear"
+                values.append(now[sf][sv] if linear else new[sf][sv])
+                slopes.append((new[sf][sv] - now[sf][sv]) / step if linear else 0.0)
+            else:
+                values.append(now[sf][sv])
+                slopes.append(now[d[0]][d[1]] if d is not None else
+                              (now[sf][sv] - prev[sf][sv]) / step if k else 0.0)
+        return values, slopes
+
+    def step(self, k, now, prev, step, scheme, extrapolation) -> dict:
+        """Every FMU stepped from t = k step to t + step, in the dict's order; returns their reads at t + step."""
+        t, new = k * step, {}
+        for name in self.runners:
+            if self.inputs_of[name]:
+                values, slopes = self.inputs(name, k, now, prev, new, step, scheme, extrapolation)
+                self.writes[name].set(values)
+                if extrapolation == "linear" and self.interpolates[name]:
+                    self.writes[name].set_slopes(slopes)
+            w = self.reads[name]
+            status = w.fmu.fmi2DoStep(w.comp, t, step, 1)
+            if status != 0:
+                raise RuntimeError(f"FMU '{name}' failed in the step from t = {t:g} s (status {status})")
+            new[name] = w.get()
+        return new
+
+
 def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], stop_time: float, step: float,
                record: list[str], params: dict[str, dict] | None = None, scheme: str = "gauss-seidel",
                extrapolation: str = "linear", tolerance: float = 1e-8) -> CoSimResult:
@@ -88,13 +162,7 @@ def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], 
     The dict order of `fmus` is the Gauss-Seidel order. Returns the `record`ed variables ("fmu.variable")
     at every communication point from 0 to stop_time.
     """
-    if scheme not in SCHEMES:
-        raise ValueError(f"scheme '{scheme}' unknown; allowed: {', '.join(SCHEMES)}")
-    if extrapolation not in EXTRAPOLATIONS:
-        raise ValueError(f"extrapolation '{extrapolation}' unknown; allowed: {', '.join(EXTRAPOLATIONS)}")
-    n = int(round(stop_time / step))
-    if n < 1 or abs(n * step - stop_time) > 1e-9 * max(stop_time, 1.0):
-        raise ValueError(f"stop_time {stop_time} s is not a whole number of communication steps {step} s")
+    n = _check_request(scheme, extrapolation, stop_time, step)
     runners = {k: v if isinstance(v, FmuRunner) else FmuRunner(str(v)) for k, v in fmus.items()}
     params = params or {}
     for name in params:
@@ -106,7 +174,6 @@ def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], 
     targets = [t for _, t, _ in conns]
     if len(set(targets)) != len(targets):
         raise ValueError("an input is driven by more than one connection")
-
     for name, r in runners.items():
         r.check_parameters(params.get(name, {}))
         fmu = r.instance()
@@ -114,57 +181,12 @@ def cosimulate(fmus: dict[str, str | FmuRunner], connections: list[Connection], 
         fmu.setupExperiment(tolerance=tolerance, startTime=0.0)
         r.set_parameters(fmu, params.get(name, {}))
         fmu.enterInitializationMode()
-    # every output any connection or the record reads, per FMU, read in one call
-    needed = [src for src, _, _ in conns] + [d for _, _, d in conns if d] + rec
-    reads = {name: _Vars(r, sorted({v for f, v in needed if f == name})) for name, r in runners.items()}
-    inputs_of = {name: [(s, d) for s, t, d in conns if t[0] == name] for name in runners}
-    writes = {name: _Vars(r, [t[1] for _, t, _ in conns if t[0] == name]) for name, r in runners.items()}
-    interpolates = {name: bool(r.model_description.coSimulation.canInterpolateInputs)
-                    for name, r in runners.items()}
-
-    # initial values: two fixed-point sweeps over the connections (direct feedthrough at t = 0)
-    now = {name: reads[name].get() for name in runners}
-    for _ in range(2):
-        for name in runners:
-            if inputs_of[name]:
-                writes[name].set([now[s[0]][s[1]] for s, _ in inputs_of[name]])
-        now = {name: reads[name].get() for name in runners}
-    for name in runners:
-        runners[name].instance().exitInitializationMode()
-    now = {name: reads[name].get() for name in runners}
-    prev = now
+    coupling = _Coupling(runners, conns, rec)
+    now = prev = coupling.initialise()
     out = np.empty((n + 1, len(rec)))
     out[0] = [now[f][v] for f, v in rec]
-
     for k in range(n):
-        t = k * step
-        new = {}
-        for name in runners:
-            if inputs_of[name]:
-                values, slopes = [], []
-                for (sf, sv), d in inputs_of[name]:
-                    if scheme == "gauss-seidel" and sf in new:  # source already at t + h
-                        if extrapolation == "linear":  # interpolate between t and t + h
-                            values.append(now[sf][sv])
-                            slopes.append((new[sf][sv] - now[sf][sv]) / step)
-                        else:  # hold the newest value
-                            values.append(new[sf][sv])
-                            slopes.append(0.0)
-                    else:  # extrapolate from t
-                        values.append(now[sf][sv])
-                        if d is not None:
-                            slopes.append(now[d[0]][d[1]])
-                        else:
-                            slopes.append((now[sf][sv] - prev[sf][sv]) / step if k else 0.0)
-                writes[name].set(values)
-                if extrapolation == "linear" and interpolates[name]:
-                    writes[name].set_slopes(slopes)
-            w = reads[name]
-            status = w.fmu.fmi2DoStep(w.comp, t, step, 1)
-            if status != 0:
-                raise RuntimeError(f"FMU '{name}' failed in the step from t = {t:g} s (status {status})")
-            new[name] = w.get()
-        prev, now = now, new
+        prev, now = now, coupling.step(k, now, prev, step, scheme, extrapolation)
         out[k + 1] = [now[f][v] for f, v in rec]
     for r in runners.values():
         r.instance().terminate()

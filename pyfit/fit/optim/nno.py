@@ -61,6 +61,45 @@ def _local(X: np.ndarray, G: np.ndarray, centre: np.ndarray, radius: float, n_va
     return X[keep], G[keep]
 
 
+def _proposal(settings: NNOSettings, X: list, G: list, searched: list, radius: float, population, it: int,
+              n_var: int):
+    """One NNO step's proposal: the surrogate trained on the points (within the trust region around the best),
+    minimised by the GA from the previous population (squeezed into the region). Returns the new point, the
+    surrogate, its predicted error there and the GA's last population."""
+    best = int(np.argmin(searched))
+    Xa, Ga = np.array(X), np.array(G)
+    if settings.trust_region:
+        lower, upper = np.clip(X[best] - radius, 0, 1), np.clip(X[best] + radius, 0, 1)
+        Xa, Ga = _local(Xa, Ga, X[best], radius, n_var)
+    else:
+        lower, upper = np.zeros(n_var), np.ones(n_var)
+    surrogate = Surrogate(settings.hidden_sizes, seed=settings.seed + it, max_epochs=settings.max_epochs,
+                          patience=settings.patience).fit(Xa, Ga)
+    sampling = population
+    if settings.trust_region:  # warm start: the previous population, squeezed into the new box
+        sampling = np.clip(population, lower, upper)
+        sampling[0] = X[best]
+    algorithm = GA(pop_size=settings.p_size, sampling=sampling, eliminate_duplicates=True)
+    res = minimize(_SurrogateProblem(surrogate, lower, upper), algorithm, ("n_gen", settings.ga_generations),
+                   seed=settings.seed + it, verbose=False)
+    x_new = np.clip(np.atleast_1d(res.X).astype(float), 0.0, 1.0)
+    return x_new, surrogate, float(surrogate.predict_error(x_new[None])[0]), res.pop.get("X")
+
+
+def _radius(radius: float, ratio: float, x_tol: float) -> float:
+    """The trust region's next radius from the ratio of the actual to the predicted decrease."""
+    return min(2 * radius, 0.5) if ratio > 0.75 else max(radius / 2, x_tol) if ratio < 0.25 else radius
+
+
+def _stalled(x_new, r_new, last_x, last_r, settings: NNOSettings) -> bool:
+    """Whether the point and its residual moved less than x_tol and y_tol (relative) since the last step."""
+    if last_x is None:
+        return False
+    dx = np.linalg.norm(x_new - last_x) / max(np.linalg.norm(last_x), 1e-12)
+    dr = np.linalg.norm(r_new - last_r) / max(np.linalg.norm(last_r), 1e-12)
+    return dx < settings.x_tol and dr < settings.y_tol
+
+
 def nno(residuals, n_var: int, settings: NNOSettings, x0: np.ndarray | None = None, callback=None,
         transform: Callable | None = None) -> OptimResult:
     """Minimise sum(residuals(x)^2) over x in [0, 1]^n_var with NNO; residuals returns a finite vector.
@@ -77,45 +116,19 @@ def nno(residuals, n_var: int, settings: NNOSettings, x0: np.ndarray | None = No
     searched = [float(np.sum(v**2)) for v in G]  # the errors the surrogate and the trust region work on
     history = [{"iteration": 0, "evaluations": i + 1, "x": X[i].tolist(), "true_error": errors[i],
                 "ann_error": None, "wall_s": time.perf_counter() - t_start} for i in range(len(X))]
-    X = list(X)
-    population = None
-    last_x, last_r = None, None
-    radius = 0.5
-    stop = "max_sim"
-    it = 0
+    X, population, last_x, last_r, radius, stop, it = list(X), None, None, None, 0.5, "max_sim", 0
     while len(X) < settings.max_sim:
         it += 1
         best = int(np.argmin(searched))
-        Xa, Ga = np.array(X), np.array(G)
-        if settings.trust_region:
-            lower, upper = np.clip(X[best] - radius, 0, 1), np.clip(X[best] + radius, 0, 1)
-            Xa, Ga = _local(Xa, Ga, X[best], radius, n_var)
-        else:
-            lower, upper = np.zeros(n_var), np.ones(n_var)
-        surrogate = Surrogate(settings.hidden_sizes, seed=settings.seed + it, max_epochs=settings.max_epochs,
-                              patience=settings.patience).fit(Xa, Ga)
-        problem = _SurrogateProblem(surrogate, lower, upper)
-        if population is None:
-            population = rng.random((settings.p_size, n_var))
-        sampling = population
-        if settings.trust_region:  # warm start: the previous population, squeezed into the new box
-            sampling = np.clip(population, lower, upper)
-            sampling[0] = X[best]
-        algorithm = GA(pop_size=settings.p_size, sampling=sampling, eliminate_duplicates=True)
-        res = minimize(problem, algorithm, ("n_gen", settings.ga_generations), seed=settings.seed + it,
-                       verbose=False)
-        population = res.pop.get("X")
-        x_new = np.clip(np.atleast_1d(res.X).astype(float), 0.0, 1.0)
-        ann_error = float(surrogate.predict_error(x_new[None])[0])
+        population = rng.random((settings.p_size, n_var)) if population is None else population
+        x_new, surrogate, ann_error, population = _proposal(settings, X, G, searched, radius, population, it, n_var)
         r_new = residuals(x_new)
-        err = float(np.sum(r_new**2))
-        g_new = g(r_new)
+        err, g_new = float(np.sum(r_new**2)), g(r_new)
         searched_new = float(np.sum(g_new**2))
         if settings.trust_region:
             predicted = float(surrogate.predict_error(X[best][None])[0]) - ann_error
-            ratio = (searched[best] - searched_new) / predicted if predicted > 0 else -1.0
-            radius = min(2 * radius, 0.5) if ratio > 0.75 else max(radius / 2, settings.x_tol) if ratio < 0.25 \
-                else radius
+            radius = _radius(radius, (searched[best] - searched_new) / predicted if predicted > 0 else -1.0,
+                             settings.x_tol)
         X.append(x_new)
         G.append(g_new)
         errors.append(err)
@@ -130,12 +143,9 @@ def nno(residuals, n_var: int, settings: NNOSettings, x0: np.ndarray | None = No
         if err < settings.fun_tol:
             stop = "fun_tol"
             break
-        if last_x is not None:
-            dx = np.linalg.norm(x_new - last_x) / max(np.linalg.norm(last_x), 1e-12)
-            dr = np.linalg.norm(r_new - last_r) / max(np.linalg.norm(last_r), 1e-12)
-            if dx < settings.x_tol and dr < settings.y_tol:
-                stop = "stall"
-                break
+        if _stalled(x_new, r_new, last_x, last_r, settings):
+            stop = "stall"
+            break
         last_x, last_r = x_new, r_new
     best = int(np.argmin(errors))
     return OptimResult(np.array(X[best]), errors[best], len(X), stop, history, time.perf_counter() - t_start)
