@@ -10,7 +10,7 @@ import pytest
 import scipy.stats
 
 from gap_cases import CI, case, diagnosed, found_where_it_acts, strength_recovered
-from pyfit.gap import attribute
+from pyfit.gap import attribute, store
 from pyfit.gap.result import Diagnosis
 from pyfit.gap import diagnose as dg
 
@@ -68,7 +68,7 @@ def test_the_loop_starts_rank_alike_at_the_sensor_rate_and_upsampled(data_root, 
     out = tmp_path / "out"
     shutil.copytree(diagnosed(data_root, fmu_dir, "hysteresis"), out)
     (out / "fits" / "hysteresis.json").unlink()
-    monkeypatch.setattr(dg, "run_fit", capture)
+    monkeypatch.setattr(store, "run_fit", capture)
     with pytest.raises(_Captured):
         dg.diagnose("sdof", case(data_root, "hysteresis"), out, CI, fmu_dir, workers=1, progress=False)
     task = captured[0]
