@@ -93,15 +93,16 @@ def test_a_pinned_refit_holds_the_given_values_and_tries_each_remaining_start_on
 
 
 def test_a_pair_with_a_loop_descends_from_each_loop_basin_and_so_does_the_loop_beside_a_held_partner():
-    """systems.combine carries the loop's basins (a weak loop beside a strong spring lies in another basin than
+    """effect.combine carries the loop's basins (a weak loop beside a strong spring lies in another basin than
     the loop alone); attribute.pinned keeps them while the loop's shape is fitted (the loop beside a held spring)
     and drops them once it is held (the spring beside the held loop has no loop basins left)."""
     from pyfit.gap.attribute import FitTask, pinned
-    from pyfit.gap.systems import SDOF_EFFECTS, combine, sdof_loop_basin
+    from pyfit.gap.effect import combine
+    from pyfit.gap.effects import candidates, sdof_loop_basin
 
-    pair = combine([SDOF_EFFECTS["cubic_stiffness"], SDOF_EFFECTS["hysteresis"]])
-    assert pair.basin is sdof_loop_basin and combine([SDOF_EFFECTS["cubic_stiffness"],
-                                                      SDOF_EFFECTS["quadratic_damping"]]).basin is None
+    pair = combine([candidates("sdof")["cubic_stiffness"], candidates("sdof")["hysteresis"]])
+    assert pair.basin is sdof_loop_basin and combine([candidates("sdof")["cubic_stiffness"],
+                                                      candidates("sdof")["quadratic_damping"]]).basin is None
     shape = {"gamma": 0.5, "delta": -1.5, "nu": 2.0}
     task = FitTask("x.fmu", (), {"m": 2.0}, {"k": 1e5, "alpha": 1e4, "k3": 0.0, **shape},
                    {n: (-10.0, 10.0) for n in ("k", "alpha", "k3", *shape)}, pair.name, 2, 120, 1, basin=pair.basin)

@@ -10,7 +10,8 @@ import pytest
 from pyfit.gap import campaign, datasets, selection
 from pyfit.gap.result import Diagnosis, Verdict
 from pyfit.gap import diagnose as dg
-from pyfit.gap.systems import DAMPER_EFFECTS, SDOF_EFFECTS, Scale
+from pyfit.gap.effect import Scale
+from pyfit.gap.effects import candidates
 
 pytestmark = pytest.mark.slow
 
@@ -49,7 +50,7 @@ def _starts_hold_none_of(truth: dict, effect) -> bool:
 @pytest.mark.parametrize("case", [0, 1, 2])
 def test_sdof_hysteresis_of_a_random_shape_is_named(tmp_path, fmu_dir, case, measured):
     truth = _sdof_hysteresis_truths(3)[case]
-    assert _starts_hold_none_of(truth, SDOF_EFFECTS["hysteresis"])
+    assert _starts_hold_none_of(truth, candidates("sdof")["hysteresis"])
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "hysteresis", seed=case, periods=2, truth=truth)
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
     assert rep.chosen_name == "hysteresis", (truth, rep.sentence, rep.ranking[:2])
@@ -70,7 +71,7 @@ def test_a_strong_element_with_a_wide_loop_on_long_sweeps_is_named_alone(tmp_pat
     s, d = float(rng.uniform(-0.5, 0.5)), float(rng.uniform(1.0, 2.5))  # γ + δ, γ - δ
     z_y = float(10.0 ** rng.uniform(3.0, 3.5))
     truth = _loop(k, nu, s, d, z_y)
-    assert _starts_hold_none_of(truth, SDOF_EFFECTS["hysteresis"])
+    assert _starts_hold_none_of(truth, candidates("sdof")["hysteresis"])
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "hysteresis", seed=3, truth=truth,
                                   style=datasets.LabStyle(excitation="sweep"))
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
@@ -92,7 +93,7 @@ def test_a_moderate_element_with_a_very_wide_loop_on_short_sweeps_is_named_alone
     s, d = float(rng.uniform(0.1, 1.5)), float(rng.uniform(0.2, 2.5))  # γ + δ (softening), γ - δ
     z_y = float(rng.uniform(150.0, 400.0))
     truth = _loop(k, nu, s, d, z_y)
-    assert _starts_hold_none_of(truth, SDOF_EFFECTS["hysteresis"])
+    assert _starts_hold_none_of(truth, candidates("sdof")["hysteresis"])
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "hysteresis", seed=6, truth=truth,
                                   style=datasets.LabStyle(excitation="sweep", outputs=("a",), record_s=6.0))
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
@@ -112,7 +113,7 @@ def test_a_weak_element_with_a_narrow_loop_is_named_and_its_strength_recovered(t
     s, d = float(rng.uniform(0.3, 1.5)), float(rng.uniform(0.5, 2.5))  # γ + δ (softening), γ - δ
     z_y = float(10.0 ** rng.uniform(0.7, 1.5))
     truth = _loop(k, nu, s, d, z_y)
-    assert _starts_hold_none_of(truth, SDOF_EFFECTS["hysteresis"])
+    assert _starts_hold_none_of(truth, candidates("sdof")["hysteresis"])
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "hysteresis", seed=4, truth=truth)
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
     assert rep.chosen_name == "hysteresis", (truth, rep.sentence, rep.ranking[:3])
@@ -151,7 +152,7 @@ def test_a_weak_loop_beside_a_strong_cubic_spring_is_named_as_both(tmp_path, fmu
     nu = float(rng.uniform(1.2, 2.2))
     truth = {**_loop(1e5 - alpha, nu, float(rng.uniform(0.1, 1.0)), float(rng.uniform(0.5, 2.5)),
                      float(rng.uniform(10.0, 30.0))), "k3": float(rng.uniform(4e8, 7e8))}
-    assert _starts_hold_none_of({k: truth[k] for k in ("gamma", "delta", "nu")}, SDOF_EFFECTS["hysteresis"])
+    assert _starts_hold_none_of({k: truth[k] for k in ("gamma", "delta", "nu")}, candidates("sdof")["hysteresis"])
     data = datasets.write_dataset(tmp_path / "data", datasets.SDOF, "cubic_stiffness+hysteresis", seed=56,
                                   truth=truth, style=datasets.LabStyle("noise", ("y",), record_s=8.0))
     rep = dg.diagnose("sdof", data, tmp_path / "out", dg.DiagnoseConfig(), fmu_dir, workers=2, progress=False)
@@ -285,7 +286,7 @@ def test_the_thesis_damper_with_hysteresis_and_softening_springs_is_named_as_bot
              "gamma": float(rng.uniform(-0.2, 0.6)), "nu": float(rng.uniform(1.05, 2.0)),
              "D": float(rng.uniform(1.5e-4, 4e-4)),
              "k_cs1": -float(rng.uniform(2e6, 5e6)), "k_cs2": -float(rng.uniform(5e6, 1.2e7))}
-    assert _starts_hold_none_of({k: truth[k] for k in ("a_bw", "beta", "gamma", "nu")}, DAMPER_EFFECTS["hysteresis"])
+    assert _starts_hold_none_of({k: truth[k] for k in ("a_bw", "beta", "gamma", "nu")}, candidates("damper")["hysteresis"])
     # the messenger's EI and Rayleigh damping drawn too: the nominal calibration starts from the FMU's values
     messenger = {"EI": float(rng.uniform(7.0, 14.0)), "alpha_pd": float(np.exp(rng.uniform(np.log(0.8), np.log(5.0)))),
                  "beta_pd": float(np.exp(rng.uniform(np.log(8e-5), np.log(5e-4))))}

@@ -17,7 +17,9 @@ from pyfit.analysis.excitation import band_noise, motion_with_derivatives
 from pyfit.gap import datasets
 from pyfit.gap import diagnose as dg
 from pyfit.gap.campaign import DAMPER_MOTIONS, DAMPER_OUTPUTS, damper_geometry
-from pyfit.gap.systems import DAMPER_EFFECTS, FAMILY, Scale
+from pyfit.gap.effect import Scale
+from pyfit.gap.effects import candidates
+from pyfit.gap.systems import FAMILY
 from pyfit.io.nominal import NominalModel
 
 RECORD_S = 6.0
@@ -75,7 +77,7 @@ def test_the_friction_range_reaches_the_force_of_a_stuck_joint():
     peak = max(np.max(np.abs(r.a)) for r in records)
     stuck = FAMILY["damper"].stuck_force(records, {"m1": m1, "m2": m2})
     assert stuck == pytest.approx(max(m1, m2) * peak, rel=1e-15)
-    friction = DAMPER_EFFECTS["coulomb_friction"].params[0]
+    friction = candidates("damper")["coulomb_friction"].params[0]
     # a soft nominal's spring force at its deflection scale (0.5 k σ_y) far below it: the stuck force bounds
     assert friction.range(Scale(1e-4, 1e-2, 10.0, {}, stuck)) == (0.0, 0.0, stuck)
     # a stiff nominal's above it: its spring force does

@@ -5,7 +5,7 @@ import pytest
 
 from damper_matrices import clamped_matrices
 from pyfit.analysis.modal import free_decay_modes, state_space_modes
-from pyfit.gap.systems import DAMPER_EFFECTS
+from pyfit.gap.effects import candidates
 
 DT = 5e-4
 # ERA on a noise-free decay integrated at rtol 1e-11 is exact up to the integrator's error (about 1e-10 of
@@ -98,7 +98,7 @@ def test_the_damper_loop_reduced_to_its_linear_part_is_a_spring_on_each_arm(runn
             "beta": rng.uniform(0.5, 3), "gamma": rng.uniform(-1, 1), "nu": rng.uniform(1, 3)}
     M, C, K = clamped_matrices()
     worst = 0.0
-    for part in DAMPER_EFFECTS["hysteresis"].linear_parts(loop):
+    for part in candidates("damper")["hysteresis"].linear_parts(loop):
         closed = {**loop, **part}
         springs = np.zeros_like(K)
         springs[0, 0], springs[2, 2] = closed["k_bw1"], closed["k_bw2"]  # x1, x2 among the free DOFs

@@ -266,7 +266,7 @@ def test_a_joint_refit_holds_each_seed_it_starts_from():
     linear values (clipped into the nominal's, the seed is another model, worse than the member alone), and stay
     the nominal's when every seed lies inside them."""
     from pyfit.gap.attribute import Fit, UnitScaling, effect_task
-    from pyfit.gap.systems import Scale, combine
+    from pyfit.gap.effect import Scale, combine
 
     system = make_system("damper", FMU_DEFAULTS)
     nominal = Fit("nominal", {**FMU_DEFAULTS, "EI": 10.3, "alpha_pd": 3.7, "beta_pd": 9.8e-7}, ["EI"], 0, 0.2, 1, 1.0)

@@ -106,7 +106,7 @@ def test_a_periodic_record_is_its_steady_period_repeated(tmp_path, runner, measu
     every period at a tight tolerance, and the truth matches the reference's record."""
     from pyfit.analysis.excitation import PeriodicSignal, multisine
     from pyfit.analysis.signals import without_offset
-    from pyfit.gap.campaign import hysteresis_loop
+    from pyfit.gap.effects import hysteresis_loop
     from pyfit.runtime.drive import drive
 
     truth = {**TRUTH, **hysteresis_loop(np.random.default_rng(2026))}

@@ -4,7 +4,9 @@ from pyfit.gap.diagnose import DiagnoseConfig
 from pyfit.gap.evidence import POOR_LINEAR_NRMSE, not_explained_lines
 from pyfit.gap.report import LISTED_IN_FULL, starts_text
 from pyfit.gap.result import Diagnosis, Gap, ModelFit, NominalFit, Verdict
-from pyfit.gap.systems import FAMILY, SDOF_EFFECTS, Scale
+from pyfit.gap.effect import Scale
+from pyfit.gap.effects import candidates
+from pyfit.gap.systems import FAMILY
 
 
 def test_a_few_starts_are_written_one_by_one():
@@ -16,7 +18,7 @@ def test_many_starts_are_summarised_by_parameter():
     """The SDOF loop's starts (more than LISTED_IN_FULL): ν's three values, the five hysteretic shares of
     k = 1e5 N/m, γ's range from the widest loop's to the largest listed γ, and where the full list is."""
     scale = Scale(1e-3, 0.2, 1e5, {})
-    starts = SDOF_EFFECTS["hysteresis"].starts(scale)
+    starts = candidates("sdof")["hysteresis"].starts(scale)
     assert len(starts) > LISTED_IN_FULL
     text = starts_text(starts)
     assert "nu in {1, 2, 3}" in text

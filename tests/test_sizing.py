@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from pyfit.gap import campaign, datasets, sizing
+from pyfit.gap import campaign, datasets, effects, sizing
 
 
 def _loop_force(p: dict, amplitude: float, omega: float, t: np.ndarray) -> np.ndarray:
@@ -25,14 +25,14 @@ def test_a_loop_scaled_as_a_whole_is_the_same_loop_times_the_gain():
     rng = np.random.default_rng(20261204)
     t = np.linspace(0.0, 0.2, 801)  # two cycles at 10 Hz
     for _ in range(4):
-        loop = campaign.hysteresis_loop(rng)
+        loop = effects.hysteresis_loop(rng)
         gain = float(np.exp(rng.uniform(np.log(0.01), np.log(1.5))))
         gain = min(gain, sizing.max_gain(loop, "sdof", "hysteresis"))
         z_y = (loop["alpha"] / loop["beta"]) ** (1.0 / loop["nu"])  # the force where the loop turns over [N]
         amplitude = 5.0 * z_y / loop["alpha"]
         z = _loop_force(loop, amplitude, 2 * np.pi * 10.0, t)
         scaled = sizing.scaled(loop, "sdof", {"hysteresis": gain})
-        assert scaled["k"] + scaled["alpha"] == pytest.approx(sizing.SDOF_STIFFNESS)
+        assert scaled["k"] + scaled["alpha"] == pytest.approx(effects.SDOF_STIFFNESS)
         assert np.max(np.abs(loop["alpha"] * amplitude * np.sin(2 * np.pi * 10.0 * t) - z)) > 3 * z_y
         z_scaled = _loop_force(scaled, amplitude, 2 * np.pi * 10.0, t)
         assert np.max(np.abs(z_scaled / gain - z)) < 1e-6 * np.max(np.abs(z))

@@ -58,8 +58,8 @@ def test_a_nonlinear_damper_sweep_driven_by_the_spline_converges_where_lines_do_
 
     rng = np.random.default_rng(7)
     base, band = campaign.damper_geometry(rng)
-    truth = {**campaign._damper_effect_truth("hysteresis", rng),
-             **campaign._damper_effect_truth("cubic_stiffness", rng)}
+    truth = {**campaign._effect_truth("damper", "hysteresis", rng),
+             **campaign._effect_truth("damper", "cubic_stiffness", rng)}
     family = dataclasses.replace(datasets.DAMPER, band_hz=band)
     data = datasets.write_dataset(tmp_path, family, "cubic_stiffness+hysteresis", base=base, truth=truth,
                                   style=datasets.LabStyle("sweep", ("x1", "x2"), "x", record_s=8.0))

@@ -12,7 +12,8 @@ from pyfit.gap import campaign, datasets, localise, selection
 from pyfit.gap import diagnose as dg
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import effect_task, nominal_task, run_fit
-from pyfit.gap.systems import combine, strength_grid
+from pyfit.gap.effect import combine
+from pyfit.gap.systems import strength_grid
 
 
 def test_the_grid_spans_each_members_strengths_and_holds_the_refit(sdof_system):

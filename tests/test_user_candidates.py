@@ -9,7 +9,7 @@ import pytest
 
 from pyfit.analysis.excitation import multisine
 from pyfit.gap import user_candidates
-from pyfit.gap.systems import Scale
+from pyfit.gap.effect import Scale
 from pyfit.io.data import write_measurement
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]

@@ -15,7 +15,8 @@ from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
 from pyfit.fit.optim.baselines import polish
 from pyfit.gap import simulate as sim
-from pyfit.gap.systems import Effect, Scale, System, with_derived
+from pyfit.gap.effect import Effect, Scale, with_derived
+from pyfit.gap.systems import System
 
 
 @dataclass
@@ -55,7 +56,7 @@ class FitTask:
     continuation: bool = True  # envelopes first, then the lowest level, then all (see run_fit)
     log_scaled: tuple = ()  # free parameters scaled to their bounds on a log scale (positive, spanning decades)
     floor: dict | None = None  # a point the result must not be worse than (the nominal: the effect at zero)
-    derived: tuple = ()  # rules giving fixed parameters from fitted ones (systems.ExponentScaled)
+    derived: tuple = ()  # rules giving fixed parameters from fitted ones (effect.ExponentScaled)
     basin: callable = None  # start values -> their basin: refit from the best start of each (a module-level
     # function, so the task pickles to a worker)
     probes: int = 1  # without a basin: the best starts descended before the best of them goes on
@@ -213,7 +214,7 @@ def run_fit(task: FitTask) -> Fit:
     """Least squares on the stacked calibration residuals within task.bounds, from the best of task.start and
     task.alternatives (_ranked_starts); with task.continuation in stages (_stages), each from the best point so
     far. Never worse than the best start. With task.basin the same from the best start of each basin (an SDOF loop
-    has one at each ν: systems.sdof_loop_basin), each with BASIN_SHARE of the budget first, then the BASINS_ON best
+    has one at each ν: effects.sdof_loop_basin), each with BASIN_SHARE of the budget first, then the BASINS_ON best
     of them with the whole budget; without it, likewise from the task.probes best starts and task.probed. With
     task.envelopes, all of it on the amplitude envelopes instead of the waveforms; never worse than task.floor."""
     t0 = time.perf_counter()

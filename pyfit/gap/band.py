@@ -23,7 +23,7 @@ import numpy as np
 from pyfit.gap import simulate as sim
 from pyfit.gap import selection
 from pyfit.gap.attribute import stacked_residuals
-from pyfit.gap.systems import with_derived
+from pyfit.gap.effect import with_derived
 
 STEP = 1e-3  # relative step of the finite-difference Jacobian
 MAX_CHANGE = 0.05  # largest relative change of any parameter at a probed point

@@ -33,11 +33,11 @@ import numpy as np
 from pyfit.gap import confidence, datasets, selection, sizing
 from pyfit.gap.diagnose import DiagnoseConfig, diagnose, load_config, misfit_at
 from pyfit.gap.result import Verdict
+from pyfit.gap.effects import BUILTINS, drawn
 from pyfit.gap.systems import FAMILY
 from pyfit.io.nominal import NominalModel
 from pyfit.runtime.batch import map_tasks
 
-EFFECTS = ("hysteresis", "cubic_stiffness", "coulomb_friction", "quadratic_damping")
 STRENGTH_RANGE = (0.05, 2.0)  # factor on the family's reference strength, drawn log-uniformly: the sizing's start
 SHARES = {"none": 0.2, "single": 0.6, "pair": 0.2}  # how often a case withholds nothing, one effect, two
 ENR_BINS = (0.0, 2.0, 5.0, 10.0, 20.0, np.inf)  # effect-to-noise ratio bins of the detection-limit table
@@ -64,46 +64,11 @@ class Case:
     sizes: dict | None = None
 
 
-def hysteresis_loop(rng) -> dict:
-    """An SDOF Bouc-Wen loop drawn across the family (theory §1.1), independent of the candidate's starts:
-    ν uniform in 1-3 (never one of the starts' whole values); the hysteretic element holds 20-70 % of the
-    stiffness sizing.SDOF_STIFFNESS (1e5 N/m) and turns over at 30-500 N; loading branch softening (γ + δ from
-    0.1 to 1.5, or mildly hardening for ν below 1.5), γ − δ from 0.2 to 2.5."""
-    nu = float(rng.uniform(1.0, 3.0))
-    s = rng.uniform(-0.5, 1.5) if nu < 1.5 else rng.uniform(0.1, 1.5)
-    d = rng.uniform(0.2, 2.5)
-    alpha = sizing.SDOF_STIFFNESS * rng.uniform(0.2, 0.7)
-    z_y = 10.0 ** rng.uniform(1.5, 2.7)
-    return {"k": sizing.SDOF_STIFFNESS - alpha, "alpha": alpha, "beta": alpha / z_y ** nu, "gamma": (s + d) / 2,
-            "delta": (s - d) / 2, "nu": nu}
-
-
-def _effect_truth(effect: str, rng) -> dict:
-    """One effect's truth parameters at a random strength (hysteresis: a random loop, its α the strength)."""
+def _effect_truth(model: str, effect: str, rng) -> dict:
+    """One effect's truth at a random strength: a factor drawn log-uniformly from STRENGTH_RANGE on the family's
+    reference, then the effect's own draw (pyfit.gap.effects: a loop's shape across the family)."""
     factor = float(np.exp(rng.uniform(*np.log(STRENGTH_RANGE))))
-    if effect == "hysteresis":
-        loop = hysteresis_loop(rng)
-        loop["alpha"] *= min(factor, 1.0)
-        loop["k"] = sizing.SDOF_STIFFNESS - loop["alpha"]
-        return loop
-    ref = datasets.SDOF.withheld[effect]
-    strength = {"cubic_stiffness": "k3", "coulomb_friction": "F_c", "quadratic_damping": "c2"}[effect]
-    return {**ref, strength: ref[strength] * factor}
-
-
-def _damper_effect_truth(effect: str, rng) -> dict:
-    """One damper effect's truth at a random strength (STRENGTH_RANGE times the damper family's reference);
-    hysteresis with a loop shape drawn across the family (a_bw 0.1-0.6, β 0.3-1.2, γ −0.2-0.6, ν 1-2.5, D
-    0.15-0.4 mm), away from the candidate's starts."""
-    factor = float(np.exp(rng.uniform(*np.log(STRENGTH_RANGE))))
-    ref = datasets.DAMPER.withheld[effect]
-    strengths = {"hysteresis": ("k_bw1", "k_bw2"), "cubic_stiffness": ("k_cs1", "k_cs2"),
-                 "coulomb_friction": ("F_c1", "F_c2"), "quadratic_damping": ("c2_1", "c2_2")}[effect]
-    truth = {**ref, **{k: ref[k] * factor for k in strengths}}
-    if effect == "hysteresis":
-        truth.update(a_bw=rng.uniform(0.1, 0.6), beta=rng.uniform(0.3, 1.2), gamma=rng.uniform(-0.2, 0.6),
-                     nu=rng.uniform(1.0, 2.5), D=rng.uniform(1.5e-4, 4e-4))
-    return {k: float(v) for k, v in truth.items()}
+    return BUILTINS[model][effect].draw(rng, factor)
 
 
 def damper_geometry(rng) -> tuple[dict, tuple]:
@@ -146,10 +111,11 @@ def draw(n: int, seed: int = 0, model: str = "sdof", excitation: str | None = No
     cases = []
     for i in range(n):
         kind = rng.choice(list(SHARES), p=list(SHARES.values()))
-        effects = [] if kind == "none" else list(rng.choice(EFFECTS, 1 if kind == "single" else 2, replace=False))
+        effects = [] if kind == "none" else list(rng.choice(drawn(model), 1 if kind == "single" else 2,
+                                                            replace=False))
         truth = {}
         for e in effects:
-            truth.update(_effect_truth(e, rng) if model == "sdof" else _damper_effect_truth(e, rng))
+            truth.update(_effect_truth(model, e, rng))
         withheld = "+".join(sorted(effects)) or "none"
         sizes = sizing.drawn_sizes([str(e) for e in effects], size_rng) or None
         if model == "sdof":

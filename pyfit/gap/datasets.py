@@ -25,6 +25,7 @@ from pyfit.io.impedance import write_impedance
 from pyfit.analysis.excitation import (Excitation, PeriodicSignal, SteppedSine, band_noise,
                                        motion_with_derivatives, multisine)
 from pyfit.reference.synthetic import UNITS, SyntheticSpec, simulate_truth
+from pyfit.gap.effects import BUILTINS, tangent
 
 
 @dataclass(frozen=True)
@@ -45,27 +46,19 @@ class Family:
     noise: float  # sensor noise standard deviation [m]
 
 
+def _withheld(family: str) -> dict:
+    """Each built-in effect's reference truth (pyfit.gap.effects), and 'none' (a null case)."""
+    return {**{n: b.truth for n, b in BUILTINS[family].items() if b.truth}, "none": {}}
+
+
 SDOF = Family(
     "SDOFBoucWen", {"m": 2.0, "c": 10.0, "k": 1e5, "alpha": 0.0},  # f0 = 35.6 Hz, zeta = 1.1 %
-    {"hysteresis": {"k": 5e4, "alpha": 5e4, "beta": 100.0, "gamma": 0.8, "delta": -1.1},
-     "cubic_stiffness": {"k3": 3e8}, "coulomb_friction": {"F_c": 1.0, "v_s": 1e-3},
-     "quadratic_damping": {"c2": 10.0}, "sensor_delay": {"sensor_delay": 1.3e-3}, "none": {}},
-    {"beta": 0.0, "k3": 0.0, "F_c": 0.0, "c2": 0.0},
-    (10.0, 25.0, 50.0), "N", (5.0, 80.0), 500.0, 2048, 1, ("y",), 5e-6)
+    _withheld("sdof"), tangent("sdof"), (10.0, 25.0, 50.0), "N", (5.0, 80.0), 500.0, 2048, 1, ("y",), 5e-6)
 
-_DAMPER_OFF = {"k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "F_c1": 0.0, "F_c2": 0.0, "c2_1": 0.0,
-               "c2_2": 0.0}
 DAMPER = Family(
-    "StockbridgeDamper", dict(_DAMPER_OFF),  # the linear FE damper of theory §1.3, its eccentric masses included
-    {"hysteresis": {"k_bw1": 600.0, "k_bw2": 1000.0, "D": 2e-4},
-     "cubic_stiffness": {"k_cs1": 8e8, "k_cs2": 2.4e9},  # hardening: the thesis's softening diverges here
-     "coulomb_friction": {"F_c1": 0.08, "F_c2": 0.12, "v_s": 1e-3},
-     "quadratic_damping": {"c2_1": 12.0, "c2_2": 20.0},
-     "sensor_delay": {"sensor_delay": 0.9e-3},  # the clamp channels 0.9 ms ahead of the responses
-     "mass_eccentricity": {"a1": lambda p: p["a1"] + 0.015, "a2": lambda p: p["a2"] + 0.015},  # 15 mm further out
-     "none": {}},
-    dict(_DAMPER_OFF),
-    (0.05e-3, 0.1e-3, 0.2e-3), "mm", (5.0, 40.0), 500.0, 2048, 2, ("x1", "x2"), 2e-6)
+    "StockbridgeDamper", tangent("damper"),  # the linear FE damper of theory §1.3, its eccentric masses included
+    _withheld("damper"), tangent("damper"), (0.05e-3, 0.1e-3, 0.2e-3), "mm", (5.0, 40.0), 500.0, 2048, 2,
+    ("x1", "x2"), 2e-6)
 
 FAMILIES = {"sdof": SDOF, "damper": DAMPER}
 PERIODS = 3

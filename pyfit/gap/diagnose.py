@@ -32,7 +32,7 @@ __all__ = ["DiagnoseConfig", "DiagnoseError", "Dataset", "default_calibration", 
 
 def tried_effects(system, cfg: DiagnoseConfig) -> list[str]:
     """The effects a diagnosis screens and refits: those `cfg.effects` names, else every effect of the system but
-    the ones offered only on request (systems.Effect.opt_in)."""
+    the ones offered only on request (effect.Effect.opt_in)."""
     return cfg.effects or [n for n, e in system.effects.items() if not e.opt_in]
 
 

@@ -100,7 +100,7 @@ def chosen_lines(best: ModelFit, gap: Gap, screening: dict, signature: str, conf
                  ) -> list[str]:
     """The evidence for the chosen model: its shrink, the prediction band where that decided, each member's share,
     the envelope-led stage where it found it, the screening's rank of each member, where the nominal misfits and
-    the signature the effect is expected to show (`signature`: systems.Effect.signature)."""
+    the signature the effect is expected to show (`signature`: effect.Effect.signature)."""
     lines = [f"held-out NRMSE {gap.overall:.4f} -> {best.heldout_gap_after:.4f} (noise floor {gap.noise_floor:.4f}): "
              f"shrink {best.shrink_pct:.1f} %"]
     if best.explains_in_band:

@@ -24,7 +24,8 @@ from pyfit.gap.attribute import STIFFNESS_SCAN, UnitScaling, effect_start
 from pyfit.gap import judge, selection
 from pyfit.gap.diagnose import DiagnoseConfig, DiagnoseError, fmu_defaults
 from pyfit.gap.result import BandMisfit, Diagnosis, Gap, LevelMisfit, ModelFit, NominalFit, Verdict
-from pyfit.gap.systems import Scale, damper_stiffness, damper_stuck_force, make_system
+from pyfit.gap.effect import Scale
+from pyfit.gap.systems import damper_stiffness, damper_stuck_force, make_system
 from pyfit.io.impedance import ImpedanceTest, read_impedance
 from pyfit.io.nominal import NominalModel, load_nominal
 from pyfit.report import plots

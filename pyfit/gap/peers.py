@@ -27,9 +27,10 @@ import numpy as np
 
 from pyfit.analysis import kinematics
 from pyfit.gap import simulate as sim
+from pyfit.gap.effects import peer_terms
 from pyfit.io.data import measurement_files, read_measurement
 
-LIBRARY = {"y^3": "cubic_stiffness", "tanh(v/v_s)": "coulomb_friction", "v|v|": "quadratic_damping"}
+LIBRARY = peer_terms("sdof")  # term -> the effect it stands for (each declared in pyfit.gap.effects)
 SIGNIFICANT = 0.01  # a first term is named when it removes at least this share of the linear model's residual
 # ... and a second one when it removes this share of what the first leaves: there the sensor noise and the errors
 # of the motion derived from the recorded one are most of what is left, and of a single effect's residual the best

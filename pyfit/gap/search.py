@@ -15,7 +15,8 @@ from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import STRENGTH_FACTORS, Fit, effect_task, pinned, screen
 from pyfit.gap.result import Gap
 from pyfit.gap.store import fit_once, fits_of
-from pyfit.gap.systems import System, combine, strength_grid
+from pyfit.gap.effect import combine
+from pyfit.gap.systems import System, strength_grid
 
 
 def simulated_on(runner, records, values: dict, system, cfg) -> dict:

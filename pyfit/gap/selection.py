@@ -157,7 +157,7 @@ def simpler_or_better(a: tuple[int, float], b: tuple[int, float], floor: float, 
     two as large, the lower misfit, but the one with fewer `parameters` (each model's count) when both misfits
     are at or below `noise` (noise_level) and its misfit is within ALIKE of the other's (each under the noise,
     two misfits further apart on the same held-out files still tell the models apart), unless `linear` (either
-    model holds a change of the linear system, systems.Effect.linear: within the noise its refit can take up the
+    model holds a change of the linear system, effect.Effect.linear: within the noise its refit can take up the
     sensor chain's linear difference, so its few parameters are no evidence); else the larger only when it
     adds enough (adds_enough) to the smaller one credited with what refitting on alone buys it (the larger one's
     budget_control, when below its misfit)."""

@@ -10,14 +10,16 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from pyfit.analysis import kinematics
-from pyfit.analysis.signals import delayed, without_offset
+from pyfit.analysis.signals import without_offset
+from pyfit.gap.effects import output_effects
 from pyfit.io.data import Measurement
 from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.drive import drive
 
 
-SENSOR_DELAY = "sensor_delay"  # candidate parameter [s]: the outputs lag the inputs by it (channel skew)
-SENSOR_GAIN = "sensor_gain"  # candidate parameter [1]: the outputs read (1 + it) times what the model gives
+# the candidates' parameters that act on the recorded channels, not in the FMU (a channel skew, a gain), each with
+# how it changes them (pyfit.gap.effects: Builtin.on_outputs), applied in this order
+ON_OUTPUTS = output_effects()
 
 # wall-clock limit of one simulation in a diagnosis [s]: a record simulates in well under a second to a few
 # seconds; a parameter set so stiff that the integrator crawls (a friction smoothed over a tiny velocity beside a
@@ -147,9 +149,8 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
     (pyfit.runtime.drive), to time it."""
     if tolerance is None:
         tolerance = tolerance_of(rec)
-    params = dict(params)
-    delay = params.pop(SENSOR_DELAY, 0.0)  # not an FMU parameter: a lag of the output channels behind the inputs
-    gain = 1.0 + params.pop(SENSOR_GAIN, 0.0)  # nor this: the output channels' gain over the model's
+    on_outputs = {n: params[n] for n in ON_OUTPUTS if n in params}  # not FMU parameters
+    params = {n: v for n, v in params.items() if n not in on_outputs}
     inputs, repeat = rec.inputs, 1
     rigid = None
     if rec.support:  # from rest relative to the support: its start moved to rest, the outputs moved back
@@ -165,8 +166,15 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
     if not res.ok:
         return None
     values = res.values if rigid is None else {k: _moved_back(runner, k, v, *rigid) for k, v in res.values.items()}
-    return {k: gain * without_offset(delayed(np.tile(v, repeat), rec.fs, delay, rec.periodic)[rec.first:])
-            for k, v in values.items()}
+    return {k: without_offset(_on_outputs(np.tile(v, repeat), on_outputs, rec)[rec.first:]) for k, v in values.items()}
+
+
+def _on_outputs(values: np.ndarray, effects: dict, rec: Record) -> np.ndarray:
+    """A simulated output as the recorded channel reads it with the effects on the channels `effects` (parameter ->
+    value) applied to it."""
+    for name, value in effects.items():
+        values = ON_OUTPUTS[name](values, value, rec.fs, rec.periodic)
+    return values
 
 
 def with_time_limits(runner: FmuRunner, records: list[Record], params: dict, upsample: int = 4,

@@ -11,19 +11,12 @@ from collections.abc import Callable
 
 import numpy as np
 
+from pyfit.gap.effects import BUILTINS
+
 SIZE_RANGE = (0.5, 20.0)  # an effect's own size over the sensor noise, drawn log-uniformly
 ROUNDS = 2  # rounds of scaling a single effect (each writes the records once), one more for a pair; the records
 # written last measure the size got
 MAX_STEP = 100.0  # one round scales a strength by at most this factor either way
-# the strength parameters each effect's size is scaled by (an SDOF loop's β follows its α: `scaled`)
-STRENGTHS = {
-    "sdof": {"hysteresis": ("alpha",), "cubic_stiffness": ("k3",), "coulomb_friction": ("F_c",),
-             "quadratic_damping": ("c2",)},
-    "damper": {"hysteresis": ("k_bw1", "k_bw2"), "cubic_stiffness": ("k_cs1", "k_cs2"),
-               "coulomb_friction": ("F_c1", "F_c2"), "quadratic_damping": ("c2_1", "c2_2")},
-}
-SDOF_STIFFNESS = 1e5  # a drawn SDOF loop's small-amplitude stiffness k + α [N/m], kept as α is scaled
-MAX_LOOP_SHARE = 0.95  # of it, the most α may take (k stays positive)
 
 
 def drawn_sizes(effects: list[str], rng) -> dict[str, float]:
@@ -32,22 +25,16 @@ def drawn_sizes(effects: list[str], rng) -> dict[str, float]:
 
 
 def max_gain(truth: dict, model: str, effect: str) -> float:
-    """The largest factor an effect's strength may take: an SDOF loop's α at most MAX_LOOP_SHARE of
-    SDOF_STIFFNESS; no bound otherwise."""
-    return MAX_LOOP_SHARE * SDOF_STIFFNESS / truth["alpha"] if (model, effect) == ("sdof", "hysteresis") else np.inf
+    """The largest factor an effect's strength may take (its declaration's bound: pyfit.gap.effects)."""
+    return BUILTINS[model][effect].largest_gain(truth)
 
 
 def scaled(truth: dict, model: str, gains: dict[str, float]) -> dict:
-    """`truth` with each effect's strength parameters (STRENGTHS) times its gain. An SDOF loop (theory §1.1) is
-    scaled as a whole: z and α by the gain g, β by g^(1-ν), so that z/g obeys the loop's law unchanged (the
-    displacement where it turns over stays) and its force is g times the loop's; k then at SDOF_STIFFNESS - α."""
+    """`truth` with each effect scaled by its gain by the effect's size rule (pyfit.gap.effect.Builtin.scale: its
+    strengths times the gain; an SDOF loop as a whole), each from the truth given."""
     out = dict(truth)
     for effect, gain in gains.items():
-        for name in STRENGTHS[model][effect]:
-            out[name] = truth[name] * gain
-        if model == "sdof" and effect == "hysteresis":
-            out["beta"] = truth["beta"] * gain ** (1.0 - truth["nu"])
-            out["k"] = SDOF_STIFFNESS - out["alpha"]
+        out.update(BUILTINS[model][effect].scale(truth, gain))
     return out
 
 

@@ -1,5 +1,5 @@
-"""The systems a diagnosis knows: FMU, nominal (linear) free parameters with their start and bounds, and
-the candidate effects of theory §6. The nominal model is what the user describes
+"""The systems a diagnosis knows: FMU, nominal (linear) free parameters with their start and bounds, and the
+candidate effects of theory §6 (declared in pyfit.gap.effects). The nominal model is what the user describes
 (pyfit.io.nominal.NominalModel); every dimension not described comes from the FMU's own defaults (the .mo
 files), none is written here.
 
@@ -11,106 +11,14 @@ that element (SI units throughout).
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.signal
 
+from pyfit.gap.effect import Effect, Scale
+from pyfit.gap.effects import candidates, switches
 from pyfit.gap.localise import excited_band
-
-
-@dataclass(frozen=True)
-class Scale:
-    """Data scale for bounds: element deflection RMS [m], its velocity RMS [m/s], nominal stiffness [N/m],
-    the nominal model's parameter values (SI) for effects that are deviations from them, and the scale of the
-    force [N] a joint transmits when it does not slip (the damper's heavier mass carried at the clamp's peak
-    acceleration, damper_stuck_force; 0 where the family has none)."""
-
-    sigma_y: float
-    sigma_v: float
-    k: float
-    nominal: dict = field(default_factory=dict)
-    stuck_force: float = 0.0
-
-
-@dataclass(frozen=True)
-class Param:
-    """A fitted parameter: name in the FMU and a function of the Scale giving (lower, start, upper). A `shape`
-    parameter is held at its start in the screening, which probes the effect's strength only; a `log` one
-    (positive, spanning decades) is fitted on a log scale."""
-
-    name: str
-    range: callable
-    shape: bool = False
-    log: bool = False
-
-
-@dataclass(frozen=True)
-class ExponentScaled:
-    """A fixed parameter whose unit depends on a fitted exponent: target = value · reference^(1 − exponent).
-    The SDOF Bouc-Wen β [m⁻¹·N^(1−ν)] (theory §1.1): value 1/σ_y and reference the force 0.3·k·σ_y keep
-    β·|z|^ν / α of order one at the data's deflection for every ν, so γ and δ stay of order one."""
-
-    target: str
-    value: float
-    reference: float
-    exponent: str
-
-    def __call__(self, params: dict) -> dict:
-        return {**params, self.target: self.value * self.reference ** (1.0 - params[self.exponent])}
-
-
-def with_derived(params: dict, rules: tuple) -> dict:
-    """params with every rule (e.g. ExponentScaled) applied in turn."""
-    for rule in rules:
-        params = rule(params)
-    return params
-
-
-@dataclass(frozen=True)
-class Effect:
-    """A candidate unmodelled effect: its free parameters, the fixed values that switch it on, the signature
-    it leaves (used as evidence in the report), and other starts of its shape parameters spanning the family
-    (`starts`: Scale -> list of {parameter: value}; the refit begins from the best of them)."""
-
-    name: str
-    params: tuple[Param, ...]
-    fixed: callable = field(default=lambda s: {})
-    signature: str = ""
-    shift_stiffness: float = 0.0  # the effect's start adds this fraction of the stiffness, taken off the nominal
-    starts: callable = field(default=lambda s: [])
-    members: tuple = ()  # the single effects of a combination (see `combine`); () for a single effect
-    signal_only: bool = False  # acts on the recorded channels, not in the FMU (pyfit.gap.simulate applies it)
-    derived: callable = field(default=lambda s: ())  # Scale -> rules giving fixed values from fitted ones
-    basin: callable = None  # start values -> the basin they lie in (the refit descends from each basin's best)
-    # fitted values -> overrides that keep only the effect's linear part (a loop closed to a spring): what a linear
-    # element there buys, where the nominal lacks that freedom ([] where it has it, or the effect has no linear part)
-    linear_parts: callable = field(default=lambda params: [])
-    # a change of the linear system itself (a geometry): within the noise threshold its refit can take up the linear
-    # difference between the model and the lab's sensor chain or another simulator, which carries over to the
-    # held-out files as well, so it does not tell a gap there (diagnose._detection)
-    linear: bool = False
-    opt_in: bool = False  # a candidate only where the diagnosis's `effects` name it (DiagnoseConfig.effects)
-
-    @property
-    def strengths(self) -> int:
-        """How many strength (not shape) parameters the effect adds: what the ranking's score charges for."""
-        return sum(not p.shape for p in self.params)
-
-    @property
-    def free_shape(self) -> bool:
-        """Whether the effect fits a shape of its own (two or more shape parameters: a hysteresis loop's), with
-        which it can take up part of another effect (a loop stiffening as a hardening spring does)."""
-        return sum(p.shape for p in self.params) >= 2
-
-    def absent(self, scale: Scale) -> dict:
-        """Parameter values at which the effect is not there (the nominal model): strengths at zero where their
-        range holds it, shape parameters and deviations (e.g. the mass offsets) at their start."""
-        out = {}
-        for p in self.params:
-            lo, st, hi = p.range(scale)
-            out[p.name] = 0.0 if (not p.shape and lo <= 0.0 <= hi) else st
-        return out
 
 
 @dataclass(frozen=True)
@@ -140,24 +48,6 @@ class System:
     outside: str = ""  # effects outside the candidates that are common in such systems (a report's hint)
 
 
-def combine(effects: list[Effect]) -> Effect:
-    """Several effects at once: their parameters, fixed values and shape starts together (named 'a + b'); the
-    basins of a member that has them (a free-shape loop's: a weak loop beside a strong spring lies in another
-    basin than the loop alone, and its refit descends from each basin's best start as the loop's does)."""
-    names = [e.name for e in effects]
-    params, seen = [], set()
-    for e in effects:
-        params += [p for p in e.params if p.name not in seen]
-        seen |= {p.name for p in e.params}
-    return Effect(" + ".join(names), tuple(params),
-                  fixed=lambda s: {k: v for e in effects for k, v in e.fixed(s).items()},
-                  signature="; ".join(f"{e.name}: {e.signature}" for e in effects),
-                  shift_stiffness=max(e.shift_stiffness for e in effects),
-                  starts=lambda s: [st for e in effects for st in e.starts(s)], members=tuple(names),
-                  derived=lambda s: tuple(r for e in effects for r in e.derived(s)),
-                  basin=next((e.basin for e in effects if e.basin), None))
-
-
 GRID_NEAR = np.geomspace(0.8, 1.25, 9)  # a member's strengths at its refit times these ...
 GRID_ACROSS = np.geomspace(1e-4, 1.0, 9)  # ... at each end of their range (one that holds zero) times these
 
@@ -182,10 +72,6 @@ def strength_grid(members: list[Effect], scale: Scale, values: dict) -> tuple[di
         if axis:  # (a member at zero whose range does not hold zero has no points: it stays where it is)
             axes.append(axis)
     return tuple({n: v for point in combo for n, v in point.items()} for combo in itertools.product(*axes))
-
-
-def _sym(scale_fn):
-    return lambda s: (-scale_fn(s), 0.0, scale_fn(s))
 
 
 # ---- SDOF --------------------------------------------------------------------------------------------------
@@ -263,109 +149,6 @@ def sdof_deflection(sim: dict, rec) -> np.ndarray:
 def sdof_stiffness(params: dict) -> float:
     return params["k"]
 
-
-# the friction's smoothing velocity v_s [m/s] (F = F_c tanh(v / v_s)): from near-ideal Coulomb (1e-3 of the
-# velocity RMS) to a friction that is still rounding off at half of it; started at 1e-2
-_stick_velocity = Param("v_s", lambda s: (1e-3 * s.sigma_v, 1e-2 * s.sigma_v, 0.5 * s.sigma_v), shape=True, log=True)
-
-# Shapes of the Bouc-Wen loop the refit starts from, spanning the family (theory §1.1 and §1.3): with β set
-# to (1/sigma_y)·(0.3·k·sigma_y)^(1-ν) (SDOF) or D to sigma_y (damper), the loading branch softens when
-# γ + δ > 0 (SDOF) or β + γ > 0 (damper) and hardens otherwise; the unloading branch likewise with γ - δ or
-# β - γ; ν from 1 (smooth) to 3 (sharp). The refit begins from the best of them on the calibration records and
-# fits the shape. The SDOF's five branch shapes are each taken at ν = 1, 2 and 3: a loop's branches and its
-# sharpness vary independently (a sharp loop that softens on both branches lies in no basin a smooth one's
-# descent reaches).
-SDOF_LOOP_BRANCHES = ({"gamma": 0.5, "delta": 0.5},    # softening loading, elastic unloading, wide loop
-                      {"gamma": 1.5, "delta": -0.5},   # softening loading, sharp unloading
-                      {"gamma": 0.5, "delta": -1.5},   # hardening loading, narrow loop
-                      {"gamma": 1.0, "delta": 0.0},    # symmetric
-                      {"gamma": 0.25, "delta": 0.75})  # nearly elastic-plastic
-SDOF_LOOP_STARTS = tuple({**branch, "nu": nu} for nu in (1.0, 2.0, 3.0) for branch in SDOF_LOOP_BRANCHES)
-DAMPER_LOOP_STARTS = ({"a_bw": 0.5, "beta": 0.75, "gamma": 0.25, "nu": 1.0},
-                      {"a_bw": 0.1, "beta": 0.5, "gamma": 0.5, "nu": 1.0},
-                      {"a_bw": 0.5, "beta": 1.5, "gamma": -0.5, "nu": 1.0},
-                      {"a_bw": 0.2, "beta": 0.25, "gamma": 0.75, "nu": 2.0},
-                      {"a_bw": 0.7, "beta": 1.0, "gamma": 0.0, "nu": 3.0})
-
-DEFAULT_SHARE = 0.1  # share of the stiffness the hysteretic element holds at small amplitude: the default start
-BETA_SHARE = 0.3  # the share that sets β's scale (ExponentScaled)
-# the shares each loop width starts from. As listed (width 1: a loop that saturates within the data's deflection),
-# from a very weak element (0.3 %: a loop whose hysteretic force is a few times the noise's; from 3 % up its refit
-# ends at a nearly linear loop several times as strong) and a weak one (3 %: it saturates early and adds a little
-# stiffness and damping) to a strong one; with γ, δ scaled by 0.1 (the shares from 3 % up) and by 0.01 (the
-# larger shares: wide loops that barely saturate there, turning over at 10^(1/ν) and 100^(1/ν) times the force
-# β's scale refers to, a mostly elastic element with a little hysteretic damping), and by 0.3 at the smaller
-# shares (a weak element whose loop turns over within a few times that force). A strong element with a wide loop
-# and a weak one with a narrow loop share the first-order nonlinearity (α·β·γ) but lie in separate basins of the
-# least squares, so the refit descends from the best start of each
-LOOP_SHARES = {1.0: (0.003, 0.03, DEFAULT_SHARE, 0.3, 0.6), 0.3: (0.003, 0.03, DEFAULT_SHARE),
-               0.1: (0.03, DEFAULT_SHARE, 0.3, 0.6), 0.01: (0.3, 0.6)}
-NARROW_FROM = 0.5  # |γ| + |δ| of a loop start from which it counts as narrow (the listed shapes: 1 to 2)
-
-
-def _sdof_loop_starts(s: Scale) -> list[dict]:
-    """Every loop shape at every width and each of its hysteretic shares of the calibrated stiffness (k + alpha =
-    the nominal k), but the default start (the first shape, as listed, at the default share)."""
-    return [{"k": (1.0 - f) * s.k, "alpha": f * s.k, **{n: v * w if n != "nu" else v for n, v in shape.items()}}
-            for w, shares in LOOP_SHARES.items() for f in shares for shape in SDOF_LOOP_STARTS
-            if (w, f, shape) != (1.0, DEFAULT_SHARE, SDOF_LOOP_STARTS[0])]
-
-
-def sdof_loop_basin(values: dict) -> tuple:
-    """The basin an SDOF loop start lies in: its ν (β's scale follows ν) and whether it is narrow or wide."""
-    return round(values["nu"], 6), abs(values["gamma"]) + abs(values["delta"]) >= NARROW_FROM
-
-
-# Strengths of the cubic spring the refit starts from, as the share k3·σ_y²/k of the linear stiffness it adds at
-# the RMS deflection (either sign: hardening and softening), log-spaced over the two and a half decades below its
-# bound (0.3): a strong cubic spring under a sweep or stepped sine jumps between branches, and a least squares
-# started at zero stops at a fraction of it
-CUBIC_SHARES = (0.001, 0.003, 0.01, 0.03, 0.1)
-
-
-def _cubic_starts(*names):
-    """Scale -> the cubic strengths of CUBIC_SHARES, both signs, for each of the spring parameters `names`."""
-    return lambda s: [{n: sign * f * s.k / s.sigma_y**2 for n in names} for f in CUBIC_SHARES for sign in (1, -1)]
-
-
-# a lag of the output channels behind the inputs (unsynchronised DAQ modules, different anti-alias filters):
-# up to half a radian at the data's dominant frequency (sigma_y / sigma_v ~ 1/ω), either sign. Linear: within the
-# noise threshold its refit takes up the group delay of the lab's anti-alias filters as well
-SENSOR_DELAY = Effect(
-    "sensor_delay", (Param("sensor_delay", _sym(lambda s: 0.5 * s.sigma_y / s.sigma_v)),),
-    signature="a phase error that grows in proportion to frequency, the same at every level", signal_only=True,
-    linear=True)
-
-# the output channels read in another proportion to the inputs than the model says (a sensor's sensitivity off by a
-# per cent or so, an amplifier's gain): a relative gain of up to 10 %, either sign. Linear, and of a damper only (a
-# family whose every parameter is fitted takes a gain up in them); offered where the configuration's effects name it
-SENSOR_GAIN = Effect(
-    "sensor_gain", (Param("sensor_gain", lambda s: (-0.1, 0.0, 0.1)),),
-    signature="a misfit in proportion to the response, the same share at every level and frequency",
-    signal_only=True, linear=True, opt_in=True)
-
-SDOF_EFFECTS = {
-    "hysteresis": Effect(
-        "hysteresis",
-        (Param("alpha", lambda s: (0.0, DEFAULT_SHARE * s.k, 2.0 * s.k)),
-         Param("gamma", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["gamma"], 5.0)),
-         Param("delta", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["delta"], 5.0)),
-         Param("nu", shape=True, range=lambda s: (1.0, SDOF_LOOP_STARTS[0]["nu"], 3.0))),
-        derived=lambda s: (ExponentScaled("beta", 1.0 / s.sigma_y, BETA_SHARE * s.k * s.sigma_y, "nu"),),
-        basin=sdof_loop_basin,
-        signature="amplitude-dependent stiffness and damping (hysteresis loops), odd distortion",
-        shift_stiffness=0.1, starts=lambda s: _sdof_loop_starts(s)),
-    "cubic_stiffness": Effect(
-        "cubic_stiffness", (Param("k3", _sym(lambda s: 0.3 * s.k / s.sigma_y**2)),),
-        signature="resonance shift with amplitude squared, odd distortion", starts=_cubic_starts("k3")),
-    "coulomb_friction": Effect(
-        "coulomb_friction", (Param("F_c", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y)), _stick_velocity),
-        signature="damping that falls with amplitude (largest misfit at the lowest level)"),
-    "quadratic_damping": Effect(
-        "quadratic_damping", (Param("c2", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y / s.sigma_v**2)),),
-        signature="damping that grows with amplitude (largest misfit at the highest level)"),
-    "sensor_delay": SENSOR_DELAY,
-}
 
 # ---- Stockbridge damper ------------------------------------------------------------------------------------
 DAMPER_OUTPUT_ORDER = {"F_clamp": 2}  # FRF of an output over the clamp displacement: /(2πf)^order (else by name)
@@ -458,48 +241,6 @@ def _damper_stuck_force_of(records, params: dict) -> float:
     return damper_stuck_force(params, max(float(np.max(np.abs(r.compared("a_base")))) for r in records))
 
 
-def _friction_range(s: Scale) -> tuple:
-    """Range of a damper joint's friction force [N]: up to half the spring force at the deflection scale or,
-    when larger, the force the joint transmits stuck (a friction that holds the arms at the lowest level leaves
-    the nominal model almost no deflection to scale it by)."""
-    return (0.0, 0.0, max(0.5 * s.k * s.sigma_y, s.stuck_force))
-
-
-def _pair(name1, name2, rng):
-    return (Param(name1, rng), Param(name2, rng))
-
-
-DAMPER_EFFECTS = {
-    "hysteresis": Effect(  # A = 1 and D = sigma_y: only β D^-ν, γ D^-ν (with ν) are identifiable (theory §1.3)
-        "hysteresis", _pair("k_bw1", "k_bw2", lambda s: (0.0, 0.05 * s.k, 0.5 * s.k))
-        + (Param("a_bw", shape=True, range=lambda s: (0.0, DAMPER_LOOP_STARTS[0]["a_bw"], 1.0)),
-           Param("beta", shape=True, range=lambda s: (0.0, DAMPER_LOOP_STARTS[0]["beta"], 5.0)),
-           Param("gamma", shape=True, range=lambda s: (-5.0, DAMPER_LOOP_STARTS[0]["gamma"], 5.0)),
-           Param("nu", shape=True, range=lambda s: (1.0, DAMPER_LOOP_STARTS[0]["nu"], 3.0))),
-        fixed=lambda s: {"A": 1.0, "D": s.sigma_y},
-        signature="amplitude-dependent stiffness and damping of the cable (hysteresis loops), odd distortion",
-        starts=lambda s: [dict(st) for st in DAMPER_LOOP_STARTS[1:]],
-        # the nominal has one EI for both arms: a loop's linear part, a stiffness per arm, is a freedom it lacks (the
-        # SDOF's k holds an SDOF loop's); closed to a spring of its stiffness before and after yield
-        linear_parts=lambda p: [{"a_bw": 1.0}, {"a_bw": 1.0, "k_bw1": p["a_bw"] * p["k_bw1"],
-                                                "k_bw2": p["a_bw"] * p["k_bw2"]}]),
-    "cubic_stiffness": Effect(
-        "cubic_stiffness", _pair("k_cs1", "k_cs2", _sym(lambda s: 0.3 * s.k / s.sigma_y**2)),
-        signature="resonance shifts with amplitude squared, odd distortion", starts=_cubic_starts("k_cs1", "k_cs2")),
-    "coulomb_friction": Effect(
-        "coulomb_friction", _pair("F_c1", "F_c2", _friction_range) + (_stick_velocity,),
-        signature="damping that falls with amplitude (largest misfit at the lowest level)"),
-    "quadratic_damping": Effect(
-        "quadratic_damping", _pair("c2_1", "c2_2", lambda s: (0.0, 0.0, 0.5 * s.k * s.sigma_y / s.sigma_v**2)),
-        signature="damping that grows with amplitude (largest misfit at the highest level)"),
-    "mass_eccentricity": Effect(  # a deviation of the mass offsets from the nominal's, up to 30 mm
-        "mass_eccentricity", (Param("a1", lambda s: (s.nominal["a1"] - 0.03, s.nominal["a1"], s.nominal["a1"] + 0.03)),
-                              Param("a2", lambda s: (s.nominal["a2"] - 0.03, s.nominal["a2"], s.nominal["a2"] + 0.03))),
-        signature="amplitude-independent shift of the modes (the same misfit at every level)", linear=True),
-    "sensor_delay": SENSOR_DELAY,
-    "sensor_gain": SENSOR_GAIN,
-}
-
 @dataclass(frozen=True)
 class _Family:
     fmu: str
@@ -528,16 +269,14 @@ class _Family:
 
 
 FAMILY = {
-    "sdof": _Family("SDOFBoucWen", {"exc_type": 0, "alpha": 0.0, "k3": 0.0, "F_c": 0.0, "c2": 0.0},
+    "sdof": _Family("SDOFBoucWen", {"exc_type": 0, **switches("sdof")},
                     ("m", "c", "k"), "k", sdof_start, sdof_file_starts, sdof_bounds, sdof_stiffness, sdof_deflection,
-                    ("y",), (), SDOF_EFFECTS, 1, outside="a joint whose loops follow another law than the "
+                    ("y",), (), candidates("sdof"), 1, outside="a joint whose loops follow another law than the "
                     "hysteresis candidate's, as a bolted joint's micro-slip does; backlash; a delay between the "
                     "channels"),
-    "damper": _Family("StockbridgeDamper",
-                      {"exc_type": 0, "k_bw1": 0.0, "k_bw2": 0.0, "k_cs1": 0.0, "k_cs2": 0.0, "F_c1": 0.0,
-                       "F_c2": 0.0, "c2_1": 0.0, "c2_2": 0.0},
+    "damper": _Family("StockbridgeDamper", {"exc_type": 0, **switches("damper")},
                       ("EI", "alpha_pd", "beta_pd"), "EI", None, damper_modal_starts, damper_bounds, damper_stiffness,
-                      damper_deflection, ("x1",), ("x_base", "v_base", "a_base"), DAMPER_EFFECTS, 2,
+                      damper_deflection, ("x1",), ("x_base", "v_base", "a_base"), candidates("damper"), 2,
                       ("alpha_pd", "beta_pd"), _damper_stuck_force_of, upsample=2, smooth_inputs=True,
                       outside="a delay between the channels; a gain between them (a sensor's sensitivity off by a "
                       "per cent: the candidate sensor_gain, where the configuration's effects name it); the "

@@ -18,7 +18,7 @@ parameters with bounds and a start rule. The diagnosis screens, refits and ranks
 
 k is the nominal model's stiffness [N/m], sigma_y and sigma_v the RMS of the nonlinear element's deflection [m]
 and rate [m/s] simulated by the calibrated nominal model, stuck_force the force [N] a damper joint transmits when
-it does not slip (the heavier end mass at the clamp's peak acceleration; 0 for the SDOF) (pyfit.gap.systems.Scale).
+it does not slip (the heavier end mass at the clamp's peak acceleration; 0 for the SDOF) (pyfit.gap.effect.Scale).
 """
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ import operator
 import pathlib
 from dataclasses import dataclass
 
-from pyfit.gap.systems import Effect, Param, Scale
+from pyfit.gap.effect import Effect, Param, Scale
 from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read_toml
 
 NAMES = ("k", "sigma_y", "sigma_v", "stuck_force")
