@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import itertools
+import json
 import os
 import pathlib
 from dataclasses import dataclass
@@ -239,9 +240,7 @@ class ModelSearch:
             return None  # the model so far, refitted on, reaches the noise
         members = list(self.members(current))
         others = [n for n in self.system.effects if n not in members and n in self.fits]
-        c = self.ctx
-        explained, strength = screen(self.system, c.fmu, c.cal, self.fits[current], c.scale, self.cfg.upsample,
-                                     others)
+        explained, strength = self.screened_at(current, others)
         if selection.nothing_to_add(self.after[current], self.explained_below, list(explained.values()),
                                     self.cfg.min_partner_explained):
             self.settled.add(current)
@@ -250,6 +249,21 @@ class ModelSearch:
         names, new, again = self.trials(current, members, partners, strength)
         self.rejoined(current, again)
         return self.step(current, names, new)
+
+    def screened_at(self, current, others) -> tuple[dict, dict]:
+        """The screening repeated at the model so far (attribute.screen: each candidate's share of its calibration
+        residual, and the strength of its Gauss-Newton step), stored as fits/<model>.screened.json with the model's
+        values, its misfits and the thresholds it was judged by (a resumed diagnosis reads it)."""
+        c, fit = self.ctx, self.fits[current]
+        path = self.path(f"{stem(current)}.screened")
+        kept = json.loads(path.read_text()) if path.is_file() else {}
+        if kept.get("key") == c.key and kept.get("params") == fit.params and set(kept["fractions"]) == set(others):
+            return kept["fractions"], kept["strengths"]
+        explained, strength = screen(self.system, c.fmu, c.cal, fit, c.scale, self.cfg.upsample, others)
+        path.write_text(json.dumps({"key": c.key, "params": fit.params, "fractions": explained, "strengths": strength,
+                                    "heldout_nrmse": self.after[current], "calibration_nrmse": fit.calibration_nrmse,
+                                    "explained_below": self.explained_below, "noise": self.above}, indent=1))
+        return explained, strength
 
     def trials(self, current, members, partners, strength) -> tuple[list, list, list]:
         """The combinations of the model so far with each partner (names); those to refit beside and jointly
