@@ -308,7 +308,7 @@ def test_the_truth_s_own_test_is_the_report_s(tmp_path):
 def test_a_short_campaign_on_a_local_dask_cluster(tmp_path, fmu_dir, measured):
     summary = campaign.run(20, tmp_path, fmu_dir, seed=0, workers=2, progress=False)
     # effects drawn from half the noise to twenty times it: many of them the data cannot decide, so the guard is on
-    # the cases they do (the 200-case campaign's: 88 % of 94, docs/validation.md; 3 binomial standard deviations
+    # the cases they do (the 200-case campaign's: 88 % of 94, docs/validation/campaigns.md; 3 binomial standard deviations
     # below it for the ten or so of 20 cases)
     measured("short campaign (20 random SDOF cases): top-1 accuracy on the cases detected and decided by the data",
              summary["top1_decided"], 0.55, at_least=True)

@@ -71,3 +71,24 @@ def test_a_scheduler_that_does_not_answer_gives_one_clear_error(tmp_path):
                          env={**os.environ, "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "2s"})
     assert res.returncode == 2 and "Traceback" not in res.stderr
     assert "error: no Dask scheduler answered at tcp://127.0.0.1:9" in res.stderr and "dask scheduler" in res.stderr
+
+
+def test_the_bundled_dataset_is_listed_copied_and_read_in_its_units(tmp_path, fmu_dir):
+    """`stockbridge examples` lists the bundled shaker test and copies it; the diagnosis reads its accelerometer
+    column, written in g, as m/s² (its RMS about the mean, from the file's own numbers, times standard gravity)."""
+    import numpy as np
+
+    from pyfit.gap.dataset_check import check_dataset
+
+    listed = run(sys.executable, "-m", "pyfit.cli", "examples")
+    assert listed.returncode == 0 and listed.stdout.startswith("lab_sweeps: ")
+    copied = run(sys.executable, "-m", "pyfit.cli", "examples", "lab_sweeps", str(tmp_path / "lab"))
+    assert copied.returncode == 0, copied.stderr
+    unknown = run(sys.executable, "-m", "pyfit.cli", "examples", "lab_sweep")
+    assert unknown.returncode == 2 and "allowed: lab_sweeps" in unknown.stderr
+    check = check_dataset("sdof", tmp_path / "lab", fmu_dir=fmu_dir)
+    assert [f.role for f in check.files] == ["calibration", "held out", "calibration"]
+    for f in check.files:
+        acc = np.genfromtxt(tmp_path / "lab" / f"{f.name}.csv", delimiter=",", skip_header=2)[:, 2]
+        (channel,) = [c for c in f.channels if c.model_variable == "a"]
+        assert channel.unit == "g" and channel.rms_si == pytest.approx(9.80665 * np.std(acc), rel=1e-9)

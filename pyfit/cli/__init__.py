@@ -21,6 +21,7 @@ COMMANDS = {
     "verify-balance": "the energy balance against a co-simulation of the span in wind",
     "element-docs": "README and reference CSV for every element FMU",
     "docs-tables": "copy the result files the commands wrote into docs/results",
+    "examples": "list the bundled datasets, or copy one into a folder to try the diagnosis on",
 }
 
 

@@ -32,7 +32,8 @@ def add_arguments(ap) -> None:
     ap.add_argument("--model", default="sdof", choices=MODELS,
                     help="nominal model: sdof (linear SDOF) or damper (linear FE damper)")
     ap.add_argument("--data", help="dataset folder (CSV + TOML pairs)")
-    ap.add_argument("--check", action="store_true", help="with --data: print what the diagnosis would read "
+    ap.add_argument("--check", action="store_true", help="with --data: print (and write to OUT/check.md) what the "
+                    "diagnosis would read "
                     "(files, levels, channels and units, RMS in SI, noise floor, split, excited band, the nominal's "
                     "resonances) and stop before any fit")
     ap.add_argument("--config", help="TOML with a [diagnose] table")
@@ -112,7 +113,10 @@ def run(args, ap) -> int:
             if not args.data:
                 ap.error("--data is required (or --impedance, --benchmark, --make-datasets, --cases)")
             if args.check:
-                print(check_text(check_dataset(args.model, args.data, args.nominal, cfg, args.fmus, args.candidates)))
+                text = check_text(check_dataset(args.model, args.data, args.nominal, cfg, args.fmus, args.candidates))
+                print(text)
+                pathlib.Path(args.out).mkdir(parents=True, exist_ok=True)
+                (pathlib.Path(args.out) / "check.md").write_text(text + "\n")
                 return 0
             report = diagnose(args.model, args.data, args.out, cfg, args.fmus, args.workers, nominal=args.nominal,
                               candidates=args.candidates)

@@ -10,6 +10,9 @@ EXAMPLE = """examples:
 Run from the repository's root, after the commands named on the docs' validation page."""
 
 
+SETTINGS = "docs/results/diagnose_settings.md"  # the diagnosis's settings table (pyfit.gap.config.settings_table)
+
+
 def add_arguments(ap) -> None:
     """Arguments of `stockbridge docs-tables`."""
     ap.add_argument("--check", action="store_true", help="only compare; exit 1 on a difference")
@@ -18,6 +21,7 @@ def add_arguments(ap) -> None:
 
 def run(args, ap) -> int:
     """Collect the results and re-render the generated blocks (or only check them)."""
+    from pyfit.gap.config import settings_table
     from pyfit.report import generated
 
     root = pathlib.Path(args.root)
@@ -29,6 +33,9 @@ def run(args, ap) -> int:
     for p in generated.collect(root):
         print(f"collected {p}")
     print(f"wrote {generated.headlines(root)}")
+    settings = root / SETTINGS
+    settings.write_text(settings_table(), encoding="utf-8")
+    print(f"wrote {settings}")
     for p in generated.render_files(root):
         print(f"rewrote {p}")
     return 0

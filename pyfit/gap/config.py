@@ -13,8 +13,8 @@ from pyfit.io.schema import ConfigError, check_sections, check_table, fail, read
 FIT, JUDGING, LAYOUT = "fit", "judging", "layout"  # a setting's role (see the module's docstring)
 
 
-def _setting(default, role: str):
-    return dataclasses.field(default=default, metadata={"role": role})
+def _setting(default, role: str, meaning: str):
+    return dataclasses.field(default=default, metadata={"role": role, "meaning": meaning})
 
 
 class DiagnoseError(ConfigError):
@@ -23,55 +23,47 @@ class DiagnoseError(ConfigError):
 
 @dataclass
 class DiagnoseConfig:
-    """Settings of a diagnosis (all optional)."""
+    """Settings of a diagnosis (all optional): each with its default, its role and what it means."""
 
-    # candidate effects to test (default: all of the system's but the opt-in ones)
-    effects: list | None = _setting(None, FIT)
-    # file stems to calibrate on (default: diagnose.default_calibration)
-    calibration: list | None = _setting(None, LAYOUT)
-    # [[lo, hi], ...] [Hz] (default: localise.default_bands, 8 over the excited range)
-    bands_hz: list | None = _setting(None, LAYOUT)
-    nominal_budget: int = _setting(60, FIT)  # FMU evaluations of the nominal calibration
-    refit_budget: int = _setting(120, FIT)  # FMU evaluations per refit with an effect
-    # FMU input grid = analysis rate x upsample (None: the family's System.upsample, for a file faster than
-    # pyfit.gap.rate.REFERENCE_HZ the fewer its rate needs: rate.drive_upsample)
-    upsample: int | None = _setting(None, FIT)
-    # a record that does not start at rest: seconds simulated from rest, not compared
-    transient_s: float = _setting(4.0, LAYOUT)
-    min_gap: float = _setting(0.005, JUDGING)  # NRMSE a gap must exceed beyond the noise floor to count
-    noise_factor: float = _setting(1.2, JUDGING)  # ... and the noise floor times this
-    close_points: float = _setting(15.0, JUDGING)  # runner-up within this many score points: reported as close
-    min_shrink_pct: float = _setting(50.0, JUDGING)  # the best effect must shrink the gap by this much to be chosen
-    # ... and bring the held-out NRMSE within explain_factor x the noise floor
-    explain_factor: float = _setting(3.0, JUDGING)
-    # ... or within the floor + explain_margin (the absolute criterion)
-    explain_margin: float = _setting(0.02, JUDGING)
-    # a nominal whose NRMSE on its best calibration file exceeds this "does not fit"
-    nominal_max_nrmse: float = _setting(0.8, JUDGING)
-    max_effects: int = _setting(2, JUDGING)  # effects combined at most (the forward selection)
-    # candidates tried as the next member of a combination (by the screening at that model)
-    partners: int = _setting(4, JUDGING)
-    beam: int = _setting(2, JUDGING)  # single effects the forward selection starts from (the best-scoring ones)
-    # share of the misfit above the noise floor a larger combination must remove
-    min_excess_cut: float = _setting(0.5, JUDGING)
-    # a combination's best starts each refitted a while before the best goes on
-    combination_probes: int = _setting(3, FIT)
-    # NRMSE a model's held-out misfit must exceed beyond the floor to add a member
-    combination_min_gap: float = _setting(0.0, JUDGING)
-    # ... and the floor (should the noise grow) times this: a weaker test than the nominal's noise_factor
-    extend_factor: float = _setting(1.1, JUDGING)
-    # a model meeting the absolute criterion is extended only when a candidate's sensitivity explains this share
-    # of its calibration residual (the screening at that model)
-    min_partner_explained: float = _setting(0.005, JUDGING)
-    # when no model meets the absolute criterion: the best ones by held-out misfit, each refitted from the best
-    # point of a grid over its members' strengths (systems.strength_grid)
-    grid_models: int = _setting(3, JUDGING)
-    # refit the single effects also when the nominal's held-out misfit is within the noise threshold (an effect
-    # too weak for that test told from noise by its refit; false: a dataset without a gap costs no refits)
-    refit_within_noise: bool = _setting(True, JUDGING)
-    # with refit_within_noise: the gap counts when a single effect's refit removes this share of the held-out
-    # misfit (selection.detected_by_refit)
-    min_detect_cut: float = _setting(0.05, JUDGING)
+    effects: list | None = _setting(None, FIT, "candidate effects to test (default: every built-in one but the "
+                                     "opt-in ones)")
+    calibration: list | None = _setting(None, LAYOUT, "file stems to calibrate on (default: every file of the "
+                                        "lowest and highest level)")
+    bands_hz: list | None = _setting(None, LAYOUT, "[[lo, hi], ...] Hz the gap is split into (default: 8 over "
+                                     "the excited range)")
+    nominal_budget: int = _setting(60, FIT, "FMU evaluations of the nominal calibration")
+    refit_budget: int = _setting(120, FIT, "FMU evaluations per refit with an effect")
+    upsample: int | None = _setting(None, FIT, "the FMU's input grid over the analysis rate (default: the "
+                                    "family's, fewer for a file faster than 500 Hz)")
+    transient_s: float = _setting(4.0, LAYOUT, "a record that does not start at rest: seconds simulated from "
+                                  "rest before it, not compared")
+    min_gap: float = _setting(0.005, JUDGING, "NRMSE a gap must exceed beyond the noise floor to count")
+    noise_factor: float = _setting(1.2, JUDGING, "... and the noise floor times this")
+    close_points: float = _setting(15.0, JUDGING, "a runner-up within this many score points is reported as close")
+    min_shrink_pct: float = _setting(50.0, JUDGING, "the share of the gap [%] a model must remove to explain it")
+    explain_factor: float = _setting(3.0, JUDGING, "... and its held-out NRMSE at most this times the noise "
+                                     "floor")
+    explain_margin: float = _setting(0.02, JUDGING, "... or at most the floor plus this (the absolute criterion)")
+    nominal_max_nrmse: float = _setting(0.8, JUDGING, "a nominal whose NRMSE on its best calibration file "
+                                        "exceeds this does not fit")
+    max_effects: int = _setting(2, JUDGING, "effects combined at most")
+    partners: int = _setting(4, JUDGING, "candidates tried as the next member of a combination")
+    beam: int = _setting(2, JUDGING, "single effects the forward selection starts from")
+    min_excess_cut: float = _setting(0.5, JUDGING, "share of the misfit above the noise a larger combination must "
+                                     "remove")
+    combination_probes: int = _setting(3, FIT, "a combination's best starts each refitted a while before the "
+                                       "best goes on")
+    combination_min_gap: float = _setting(0.0, JUDGING, "NRMSE a model's held-out misfit must exceed beyond the "
+                                          "noise to add a member")
+    extend_factor: float = _setting(1.1, JUDGING, "... and the noise times this")
+    min_partner_explained: float = _setting(0.005, JUDGING, "a model that explains the data is extended only when "
+                                            "a candidate's sensitivity explains this share of its residual")
+    grid_models: int = _setting(3, JUDGING, "when nothing explains the data: the models refitted from the best "
+                                "point of a grid over their strengths")
+    refit_within_noise: bool = _setting(True, JUDGING, "refit the single effects also when the nominal fits "
+                                        "within the noise threshold (a weak effect told from noise)")
+    min_detect_cut: float = _setting(0.05, JUDGING, "... the gap then counts when a refit removes this share of "
+                                     "the held-out misfit")
 
 
 def load_config(path) -> DiagnoseConfig:
@@ -100,3 +92,11 @@ def _kind(f: dataclasses.Field):
 
 def _spec() -> dict:
     return {f.name: (_kind(f), False, f.default) for f in dataclasses.fields(DiagnoseConfig)}
+
+
+def settings_table() -> str:
+    """The settings as a Markdown table: name, default, role and meaning (the documentation's reference)."""
+    rows = ["| setting | default | role | meaning |", "|---|---|---|---|"]
+    rows += [f"| `{f.name}` | {'—' if f.default is None else repr(f.default).lower()} | {f.metadata['role']} | "
+             f"{f.metadata['meaning']} |" for f in dataclasses.fields(DiagnoseConfig)]
+    return "\n".join(rows) + "\n"

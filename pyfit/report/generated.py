@@ -23,6 +23,12 @@ RESULTS = {
     "docs/results/tests.md": ("results/tests.md", "python -m pytest"),
     "docs/results/quickstart.md": ("results/quickstart/summary.md",
                                    "stockbridge fit --repeats 2 --out results/quickstart"),
+    "docs/results/tutorial_check.md": ("results/tutorial/check.md",
+                                       "stockbridge examples lab_sweeps results/lab_sweeps && stockbridge diagnose "
+                                       "--model sdof --data results/lab_sweeps --check --out results/tutorial"),
+    "docs/results/tutorial_report.md": ("results/tutorial/report.md",
+                                        "stockbridge diagnose --model sdof --data results/lab_sweeps --out "
+                                        "results/tutorial"),
     "docs/results/diagnose_cases.md": ("results/diagnose_cases/summary.md",
                                        "stockbridge diagnose --make-datasets results/gap_cases && "
                                        "stockbridge diagnose --cases results/gap_cases --out "
@@ -224,14 +230,14 @@ def _peers_headline(res: pathlib.Path) -> str | None:
             f"effects, `stockbridge diagnose` names exactly what was withheld in {ours[3]} % ({ours[6]} % of "
             f"the {ours[5]} whose weakest effect is at least {strong[1]} × the noise); the best equation-error "
             f"method, {best[0]}, in {best[3]} % ({best[6]} %); false alarms on {ours[8]} null cases: {ours[7]} and "
-            f"{best[7]} ([validation](../validation.md#side-by-side-with-the-tools-a-user-would-pick-instead)).")
+            f"{best[7]} ([validation](../validation/peers.md)).")
 
 
 def _campaign_headline(res: pathlib.Path, name: str = "campaign.md", label: str = "Validation campaign",
                        cases: str = "SDOF cases", drawn: str = "random loop shapes, excitations, sensors",
-                       anchor: str = "validation-campaign", first: bool = True) -> str | None:
+                       page: str = "campaigns.md", first: bool = True) -> str | None:
     """A validation campaign's accuracy, from its summary `name` (None without it): the SDOF campaign's by default;
-    `cases`, `drawn` and `anchor` say what it drew and where the validation page shows it; `first`: the line that
+    `cases`, `drawn` and `page` say what it drew and which validation page shows it; `first`: the line that
     says which misses the data cannot decide (a later line refers to it)."""
     path = res / name
     if not path.is_file():
@@ -251,7 +257,7 @@ def _campaign_headline(res: pathlib.Path, name: str = "campaign.md", label: str 
                "aside" + (" (a gap within the noise, the named model fitting the held-out files at least as well as "
                           "the truth, or the truth itself removing too little of the gap to be named)" if first else
                           "") if decided else "")
-            + f"; false alarms: {m[4]} of {m[3]} null cases ([validation](../validation.md#{anchor})).")
+            + f"; false alarms: {m[4]} of {m[3]} null cases ([validation](../validation/{page})).")
 
 
 def headlines(root: pathlib.Path) -> pathlib.Path:
@@ -266,22 +272,22 @@ def headlines(root: pathlib.Path) -> pathlib.Path:
         f"{_measured(tests, 'SDOF FMU on the official benchmark multisine')} dB (multisine) and "
         f"{_measured(tests, 'SDOF FMU on the official benchmark sine sweep')} dB (sweep); identified from its own "
         f"estimation data it reaches {_measured(tests, 'Bouc-Wen benchmark identification')} dB on the official "
-        "multisine ([validation](../validation.md)).",
+        "multisine ([validation](../validation/tests.md)).",
         f"- **Gap diagnosis**: the withheld effect (or \"no significant gap\") is named in "
         f"{_cases(root, 'diagnose_lab')} lab-style SDOF sweeps recorded by an accelerometer, a skew between the "
-        "channels included ([diagnosis](../guide/diagnose.md)).",
+        "channels included ([cases](../validation/cases.md)).",
         _campaign_headline(res),
         _campaign_headline(res, "campaign_damper.md", "Damper campaign", "catalogue dampers",
                            "masses, arms, offsets, messenger stiffness and damping, loop shapes, excitations and "
-                           "sensors drawn; the geometry described to the diagnosis", "damper-cases", first=False),
+                           "sensors drawn; the geometry described to the diagnosis", "damper-campaigns.md", first=False),
         _peers_headline(res),
         f"- **Damper physics**: the damper FMU's clamp power matches a harmonic solution of independently "
         f"assembled 6-DOF matrices to a relative error of "
-        f"{_measured(tests, 'damper FMU mean clamp power')} ([validation](../validation.md)).",
+        f"{_measured(tests, 'damper FMU mean clamp power')} ([validation](../validation/tests.md)).",
         f"- **Speed**: an SDOF evaluation through the FMU costs {speed[1]}× a bare C loop of the same integrator "
-        "([validation](../validation.md#speed))." if speed else None,
+        "([validation](../validation/crosscheck-and-speed.md#speed))." if speed else None,
         f"- **Tests**: {run[1]} pass in {run[2]} s on {run[3]} cores, each model against an independent "
-        "computation ([validation](../validation.md))." if run else None,
+        "computation ([validation](../validation/tests.md))." if run else None,
     ]
     out = res / "headlines.md"
     out.write_text("\n".join(line for line in lines if line) + "\n", encoding="utf-8")
