@@ -84,7 +84,8 @@ def test_the_check_command_prints_it_and_stops_before_any_fit(tmp_path, fmu_dir,
                  str(out), "--check"]) == 0
     printed = capsys.readouterr().out
     assert printed.startswith("# Dataset check:") and "| run0 | level" not in printed and "10 N" in printed
-    assert not out.exists()  # nothing fitted, nothing written
+    assert sorted(q.name for q in out.iterdir()) == ["check.md"]  # nothing fitted: only what it printed
+    assert (out / "check.md").read_text() == printed
 
 
 def test_the_check_raises_what_the_diagnosis_would(tmp_path, fmu_dir):

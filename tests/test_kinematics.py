@@ -79,3 +79,21 @@ def test_a_wide_multisine_read_by_an_accelerometer_keeps_its_lowest_lines(measur
     # 1/w^2 amplifies it most. The Welch band (1e-3 of the peak: from 13.5 Hz) loses the lowest lines: 0.14
     measured("displacement integrated from an accelerometer on a 3-75 Hz multisine flat in displacement (noise "
              "1e-4 of the RMS): RMS error / RMS", np.std(got - x) / np.std(x), 0.02)
+
+
+def test_the_energy_band_and_the_share_below_it_tell_a_drift_from_leakage():
+    """A 10-20 Hz sweep from rest over 8 s at 500 Hz: its energy band is 8-22 Hz (its abrupt start and end leak a
+    little beyond the swept band), and under half its lower
+    edge its Hann-windowed energy share is far below a drift's; the same with a slow random drift of 2 % of its RMS
+    added holds about 1e-3 of the energy there (the squared 2 %, and more of the walk's power lies below)."""
+    from pyfit.analysis.kinematics import energy_band, share_below
+
+    fs = 500.0
+    t = np.arange(int(8 * fs)) / fs
+    sweep = np.sin(2 * np.pi * (10 * t + 10 / 16 * t**2))
+    lo, hi = energy_band(sweep, fs)
+    assert 7.5 <= lo <= 10.0 and 20.0 <= hi <= 22.5
+    assert share_below(sweep, fs, lo / 2) < 1e-5
+    walk = np.convolve(np.cumsum(np.random.default_rng(3).normal(size=t.size)), np.ones(500), "same")
+    drift = 0.02 * np.std(sweep) * (walk - walk.mean()) / np.std(walk)
+    assert 2e-4 < share_below(sweep + drift, fs, lo / 2) < 1e-2

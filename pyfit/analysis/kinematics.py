@@ -38,6 +38,24 @@ def excited_band(u: np.ndarray, fs: float, fraction: float = 1e-3, samples_per_p
     return float(f[on[0]]), float(f[on[-1]])
 
 
+def energy_band(y: np.ndarray, fs: float, share: float = 0.998) -> tuple[float, float]:
+    """[f_lo, f_hi] Hz holding `share` of the record's energy (its DFT, the mean removed), the rest split evenly
+    below and above: a sensor's slow drift, a small share of the energy, stays outside it."""
+    power = np.abs(np.fft.rfft(np.asarray(y, float) - np.mean(y))) ** 2
+    f = np.fft.rfftfreq(len(y), 1.0 / fs)
+    cum = np.cumsum(power)
+    tail = (1.0 - share) / 2 * cum[-1]
+    return float(f[np.searchsorted(cum, tail)]), float(f[min(np.searchsorted(cum, cum[-1] - tail), len(f) - 1)])
+
+
+def share_below(y: np.ndarray, fs: float, cutoff_hz: float) -> float:
+    """The share of the record's energy below cutoff_hz [Hz], from its Hann-windowed DFT (the mean removed): the
+    window keeps the leakage of a record cut at its ends (a sweep from rest) from passing for content there."""
+    y = np.asarray(y, float) - np.mean(y)
+    power = np.abs(np.fft.rfft(y * np.hanning(len(y)))) ** 2
+    return float(power[np.fft.rfftfreq(len(y), 1.0 / fs) < cutoff_hz].sum() / power.sum())
+
+
 # a line of a periodic record is excited when its power (of the averaged period) is above LINE_FRACTION of the
 # strongest line's and, with two periods or more, LINE_SNR times the noise there (the period-to-period scatter's
 # median over LINE_NEIGHBOURS lines either side). A fraction of the peak alone fails on a wide multisine read by

@@ -224,6 +224,19 @@ def step_quadratics(u: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
     return np.append(slope, spline(t[-1], 1)), np.append(curvature, spline(t[-1], 2))
 
 
+HIGH_PASS_ORDER = 4  # of the zero-phase Butterworth high_passed applies (twice: forward and backward)
+
+
+def high_passed(y: np.ndarray, fs: float, cutoff_hz: float) -> np.ndarray:
+    """y without its content below cutoff_hz [Hz]: a zero-phase Butterworth high-pass of HIGH_PASS_ORDER, run
+    forward and backward (its magnitude 1/(1 + (f_c/f)^8), 0.996 at twice the cutoff), the record's ends padded by
+    odd reflection."""
+    import scipy.signal
+
+    sos = scipy.signal.butter(HIGH_PASS_ORDER, cutoff_hz, "highpass", fs=fs, output="sos")
+    return scipy.signal.sosfiltfilt(sos, np.asarray(y, float), padtype="odd")
+
+
 def delayed(y: np.ndarray, fs: float, delay_s: float, periodic: bool = False) -> np.ndarray:
     """y(t - delay_s) on y's own grid [s]: a periodic record by a phase shift of its DFT (exact for whole
     periods), otherwise by its cubic spline, held at the first or last sample beyond the record."""

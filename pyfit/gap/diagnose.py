@@ -305,6 +305,7 @@ def _judged(p: Prepared, c: Calibrated, w: Which, model: str, data_dir, clock: S
         set_aside={name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in data.aside.items()},
         voltage_channels=tuple(data.voltages), clipped_channels=data.clipped,
         analysis_rate={**asdict(data.rate), "drive_upsample": cfg.upsample, "recorded_hz": data.recorded_hz},
+        compared_from_hz={r.name: r.compared_from_hz for r in c.records if r.compared_from_hz},
         stage_s=dict(clock.stages), figures=report.figures_for(c.records, d.nominal.params))
 
 

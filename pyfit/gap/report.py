@@ -170,6 +170,18 @@ def _voltage_lines(channels: list[str]) -> list[str]:
             "not.", ""]
 
 
+def _compared_lines(compared_from: dict) -> list[str]:
+    """Files whose displacement input was integrated from a velocity or an acceleration: the frequency below which
+    the data cannot speak."""
+    if not compared_from:
+        return []
+    below = ", ".join(f"{name} ({hz:.2g} Hz)" for name, hz in compared_from.items())
+    return [f"The displacement input was integrated from a velocity or an acceleration in {below}: it drifts below "
+            "that frequency (a sensor's offset and slow noise, integrated), where the data cannot tell the model's "
+            "response from the drift; the outputs are compared above it, and after the first seconds (the drift's "
+            "unknown start sets the model ringing).", ""]
+
+
 def _rate_lines(rate: dict | None) -> list[str]:
     """The files brought to the dataset's rate (pyfit.gap.rate.common_rate), and the rate the records were analysed
     at and the FMU's drive grid, for files faster than the rate the families' drive grids were set at."""
@@ -198,7 +210,7 @@ def markdown(d: Diagnosis) -> str:
     lines += [f"Calibrated on {', '.join(d.calibration_files)}; held out: {', '.join(d.held_out_files)}. Levels "
               f"ordered by {d.level_order}.", ""]
     lines += _set_aside_lines(d.set_aside) + _voltage_lines(d.voltage_channels) + clipped_lines(d.clipped_channels) \
-        + _rate_lines(d.analysis_rate)
+        + _rate_lines(d.analysis_rate) + _compared_lines(d.compared_from_hz)
     lines += [
         f"Held-out gap (NRMSE) of the nominal model: **{g.overall:.4f}**; noise floor from the data: "
         f"{g.noise_floor:.4f} ({', '.join(g.noise_floor_method)}){_scaled_floor(g)}; nominal calibration NRMSE "

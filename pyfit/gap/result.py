@@ -153,6 +153,8 @@ class Diagnosis:
     voltage_channels: tuple[str, ...] = ()
     clipped_channels: dict = dataclasses.field(default_factory=dict)
     analysis_rate: dict | None = None
+    compared_from_hz: dict = dataclasses.field(default_factory=dict)  # file -> the frequency its outputs are
+    # compared above (a displacement integrated from an accelerometer drifts below it)
     stage_s: dict = dataclasses.field(default_factory=dict)
     figures: tuple[str, ...] = ()  # the figures beyond the gap map and the overlay
 

@@ -10,7 +10,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from pyfit.analysis import kinematics
-from pyfit.analysis.signals import without_offset
+from pyfit.analysis.kinematics import ORDER
+from pyfit.analysis.signals import high_passed, without_offset
 from pyfit.gap.effects import output_effects
 from pyfit.io.data import Measurement
 from pyfit.runtime.fmu import FmuRunner
@@ -52,6 +53,8 @@ class Record:
     smooth_inputs: bool = False  # the FMU is driven by the inputs' cubic spline (pyfit.runtime.drive)
     max_wall_s: float = MAX_WALL_S  # a simulation of it still running after this many seconds [s] counts as failed
     # (a diagnosis sets it from the calibrated nominal's own simulation time: with_time_limits)
+    compared_from_hz: float = 0.0  # outputs compared above this [Hz] only (measured and simulated through the same
+    # high-pass: a motion input integrated from a velocity or an acceleration carries a drift below it)
 
     def compared(self, name: str) -> np.ndarray:
         """An input over the samples that are compared (from `first` on)."""
@@ -98,24 +101,57 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0, smoo
         raise ValueError(f"{m.path}: {n} samples is not a whole number of periods of {spp} "
                          "([excitation] samples_per_period)")
     inputs = {k: without_offset(v) for k, v in m.by_variable("inputs").items()}  # a sensor's zero is no load
-    derived = ()
-    if motion:
-        recorded = {kind: inputs[var] for kind, var in zip("xva", motion) if var in inputs}
-        if not recorded:
-            raise ValueError(f"{m.path.with_suffix('.toml')}: [inputs] needs the motion as one of "
-                             f"{', '.join(motion)} (model_variable), in m, mm, m/s, m/s2 or g")
-        band = kinematics.excited_band(next(iter(recorded.values())), m.sample_rate_hz, samples_per_period=spp)
-        full = kinematics.complete(recorded, m.sample_rate_hz, band, periodic=bool(spp))
-        derived = tuple(var for kind, var in zip("xva", motion) if var not in inputs)
-        inputs = {**inputs, **{var: full[kind] for kind, var in zip("xva", motion)}}
+    inputs, derived, compared_from = _with_motion(m, inputs, motion, spp)
+    drifts, compared_from = compared_from < 0, abs(compared_from)
     weights = {ch.model_variable: ch.weight for ch in m.outputs.values()}
-    # at most a quarter of a short record is given up to the start-up transient
-    first = 0 if spp or starts_at_rest(m) else min(int(round(transient_s * m.sample_rate_hz)), n // 4)
-    outputs = {k: without_offset(v[first:]) for k, v in m.by_variable("outputs").items()}
-    # a file without a `level` label is named by its file in every table and figure
+    # at most a quarter of a short record is given up to the start-up transient: of a record that does not start at
+    # rest, and of one whose displacement was integrated from a drifting sensor (the drift's start, an acceleration
+    # the model at rest meets as a step, sets it ringing)
+    settled = starts_at_rest(m) and not drifts
+    first = 0 if spp or settled else min(int(round(transient_s * m.sample_rate_hz)), n // 4)
     support = motion[:2] if motion and motion[0] in derived and not spp else ()  # x integrated
+    outputs = {k: without_offset(_compared(v, m.sample_rate_hz, compared_from)[first:])
+               for k, v in m.by_variable("outputs").items()}
+    # a file without a `level` label is named by its file in every table and figure
     return Record(m.name, m.level or m.name, float(m.level_value if m.level_value is not None else 0.0),
-                  m.sample_rate_hz, inputs, outputs, spp, weights, derived, first, support, smooth_inputs)
+                  m.sample_rate_hz, inputs, outputs, spp, weights, derived, first, support, smooth_inputs,
+                  compared_from_hz=compared_from)
+
+
+COMPARED_FROM = 0.5  # outputs are compared above this share of the excited band's lower edge where x was integrated
+# a recorded motion with more than this share of its energy below that frequency drifts (an accelerometer whose slow
+# noise is 2 % of its RMS: 1e-3 of its energy there, kinematics.share_below; the generator's exact clamp motion under
+# a sweep, a stepped sine or band-limited noise: 2e-7 to 1.1e-5, tests/test_integrated_drift.py)
+DRIFT_SHARE = 1e-4
+
+
+def _with_motion(m: Measurement, inputs: dict, motion: tuple, spp: int) -> tuple[dict, tuple, float]:
+    """The inputs with the model's displacement, velocity and acceleration (`motion`) each derived from the
+    recorded one where not recorded (kinematics.complete); the ones derived; and the frequency [Hz] the record is
+    compared above: a displacement integrated from a record that is not periodic drifts below the excited band
+    (an accelerometer's offset and 1/f noise, integrated twice), and the outputs are compared above COMPARED_FROM
+    of the lower edge of the band that holds nearly all of the recorded motion's energy (kinematics.energy_band:
+    the drift, a small share of it, stays below); 0: everything compared; negative where the recorded motion holds
+    more than DRIFT_SHARE of its energy below it (a drifting sensor)."""
+    if not motion:
+        return inputs, (), 0.0
+    recorded = {kind: inputs[var] for kind, var in zip("xva", motion) if var in inputs}
+    if not recorded:
+        raise ValueError(f"{m.path.with_suffix('.toml')}: [inputs] needs the motion as one of "
+                         f"{', '.join(motion)} (model_variable), in m, mm, m/s, m/s2 or g")
+    fs, lowest = m.sample_rate_hz, min(recorded, key=ORDER.get)
+    compared_from = 0.0 if spp or lowest == "x" else COMPARED_FROM * kinematics.energy_band(recorded[lowest], fs)[0]
+    if compared_from and kinematics.share_below(recorded[lowest], fs, compared_from) > DRIFT_SHARE:
+        compared_from = -compared_from  # a drift shows: the start is not compared either (record_of)
+    band = kinematics.excited_band(next(iter(recorded.values())), fs, samples_per_period=spp)
+    full = kinematics.complete(recorded, fs, band, periodic=bool(spp))
+    derived = tuple(var for kind, var in zip("xva", motion) if var not in inputs)
+    return {**inputs, **{var: full[kind] for kind, var in zip("xva", motion)}}, derived, compared_from
+
+
+def _compared(y: np.ndarray, fs: float, from_hz: float) -> np.ndarray:
+    """An output as it is compared: above from_hz only (signals.high_passed; 0: as it is)."""
+    return high_passed(y, fs, from_hz) if from_hz > 0 else y
 
 
 def scaled(rec: Record, factor: float) -> Record:
@@ -142,7 +178,8 @@ def tolerance_of(rec: Record) -> float:
 def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, lead_periods: int = 1,
              tolerance: float | None = None, outputs=None, remembered: bool = True) -> dict | None:
     """Outputs (model variable -> the compared samples of the record's grid, less their mean; default: the
-    record's outputs) for FMU parameters params; None on failure. A periodic record is driven by its period
+    record's outputs, through the record's high-pass where it has one: Record.compared_from_hz) for FMU parameters
+    params; None on failure. A periodic record is driven by its period
     averaged over the record (pyfit.runtime.drive): its steady state, one period simulated after lead_periods
     (at least one) and repeated over the record's periods. tolerance: the integrator's (None: the record's,
     tolerance_of). remembered=False: the FMU runs even where this process made the same run before
@@ -166,7 +203,9 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
     if not res.ok:
         return None
     values = res.values if rigid is None else {k: _moved_back(runner, k, v, *rigid) for k, v in res.values.items()}
-    return {k: without_offset(_on_outputs(np.tile(v, repeat), on_outputs, rec)[rec.first:]) for k, v in values.items()}
+    from_hz = rec.compared_from_hz if outputs is None else 0.0  # the record's own outputs: as they are compared
+    return {k: without_offset(_compared(_on_outputs(np.tile(v, repeat), on_outputs, rec), rec.fs, from_hz)[rec.first:])
+            for k, v in values.items()}
 
 
 def _on_outputs(values: np.ndarray, effects: dict, rec: Record) -> np.ndarray:
