@@ -102,12 +102,11 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0, smoo
                          "([excitation] samples_per_period)")
     inputs = {k: without_offset(v) for k, v in m.by_variable("inputs").items()}  # a sensor's zero is no load
     inputs, derived, compared_from = _with_motion(m, inputs, motion, spp)
-    drifts, compared_from = compared_from < 0, abs(compared_from)
     weights = {ch.model_variable: ch.weight for ch in m.outputs.values()}
     # at most a quarter of a short record is given up to the start-up transient: of a record that does not start at
     # rest, and of one whose displacement was integrated from a drifting sensor (the drift's start, an acceleration
     # the model at rest meets as a step, sets it ringing)
-    settled = starts_at_rest(m) and not drifts
+    settled = starts_at_rest(m) and not compared_from
     first = 0 if spp or settled else min(int(round(transient_s * m.sample_rate_hz)), n // 4)
     support = motion[:2] if motion and motion[0] in derived and not spp else ()  # x integrated
     outputs = {k: without_offset(_compared(v, m.sample_rate_hz, compared_from)[first:])
@@ -118,7 +117,7 @@ def record_of(m: Measurement, motion: tuple = (), transient_s: float = 4.0, smoo
                   compared_from_hz=compared_from)
 
 
-COMPARED_FROM = 0.5  # outputs are compared above this share of the excited band's lower edge where x was integrated
+COMPARED_FROM = 0.5  # outputs compared above this share of the excited band's lower edge where x drifts
 # a recorded motion with more than this share of its energy below that frequency drifts (an accelerometer whose slow
 # noise is 2 % of its RMS: 1e-3 of its energy there, kinematics.share_below; the generator's exact clamp motion under
 # a sweep, a stepped sine or band-limited noise: 2e-7 to 1.1e-5, tests/test_integrated_drift.py)
@@ -127,12 +126,12 @@ DRIFT_SHARE = 1e-4
 
 def _with_motion(m: Measurement, inputs: dict, motion: tuple, spp: int) -> tuple[dict, tuple, float]:
     """The inputs with the model's displacement, velocity and acceleration (`motion`) each derived from the
-    recorded one where not recorded (kinematics.complete); the ones derived; and the frequency [Hz] the record is
-    compared above: a displacement integrated from a record that is not periodic drifts below the excited band
-    (an accelerometer's offset and 1/f noise, integrated twice), and the outputs are compared above COMPARED_FROM
-    of the lower edge of the band that holds nearly all of the recorded motion's energy (kinematics.energy_band:
-    the drift, a small share of it, stays below); 0: everything compared; negative where the recorded motion holds
-    more than DRIFT_SHARE of its energy below it (a drifting sensor)."""
+    recorded one where not recorded (kinematics.complete); the ones derived; and the frequency [Hz] above which the
+    record is compared (0: all of it). A displacement integrated from a record that is not periodic drifts below the
+    excited band where its sensor drifts (an accelerometer's offset and slow noise, integrated twice): where the
+    recorded motion holds more than DRIFT_SHARE of its energy below COMPARED_FROM of the lower edge of the band
+    that holds nearly all of it (kinematics.energy_band, share_below), the outputs are compared above that
+    frequency only."""
     if not motion:
         return inputs, (), 0.0
     recorded = {kind: inputs[var] for kind, var in zip("xva", motion) if var in inputs}
@@ -140,9 +139,8 @@ def _with_motion(m: Measurement, inputs: dict, motion: tuple, spp: int) -> tuple
         raise ValueError(f"{m.path.with_suffix('.toml')}: [inputs] needs the motion as one of "
                          f"{', '.join(motion)} (model_variable), in m, mm, m/s, m/s2 or g")
     fs, lowest = m.sample_rate_hz, min(recorded, key=ORDER.get)
-    compared_from = 0.0 if spp or lowest == "x" else COMPARED_FROM * kinematics.energy_band(recorded[lowest], fs)[0]
-    if compared_from and kinematics.share_below(recorded[lowest], fs, compared_from) > DRIFT_SHARE:
-        compared_from = -compared_from  # a drift shows: the start is not compared either (record_of)
+    cut = 0.0 if spp or lowest == "x" else COMPARED_FROM * kinematics.energy_band(recorded[lowest], fs)[0]
+    compared_from = cut if cut and kinematics.share_below(recorded[lowest], fs, cut) > DRIFT_SHARE else 0.0
     band = kinematics.excited_band(next(iter(recorded.values())), fs, samples_per_period=spp)
     full = kinematics.complete(recorded, fs, band, periodic=bool(spp))
     derived = tuple(var for kind, var in zip("xva", motion) if var not in inputs)
