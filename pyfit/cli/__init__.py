@@ -22,6 +22,7 @@ COMMANDS = {
     "element-docs": "README and reference CSV for every element FMU",
     "docs-tables": "copy the result files the commands wrote into docs/results",
     "examples": "list the bundled datasets, or copy one into a folder to try the diagnosis on",
+    "plan-test": "the test that would separate a diagnosis's close candidates, and its drive file",
 }
 
 

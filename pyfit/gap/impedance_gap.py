@@ -236,7 +236,8 @@ def _ranking(fits: dict, before: float, reference: float, explained_below: float
         ranking.append(ModelFit(
             name, (name,), selection.score(before, fit.heldout_error, reference, fit.n_added), before,
             fit.heldout_error, shrink, {n: fit.params[n] for n in fit.free}, fit.n_added, fit.calibration_error,
-            fit.evaluations, selection.explains(shrink, fit.heldout_error, explained_below, cfg.min_shrink_pct)))
+            fit.evaluations, selection.explains(shrink, fit.heldout_error, explained_below, cfg.min_shrink_pct),
+            values=dict(fit.params)))
     return sorted(ranking, key=lambda d: -d.score)
 
 
@@ -293,7 +294,7 @@ def diagnose_impedance(csv_path, out_dir, cfg: DiagnoseConfig | None = None, fmu
     d = Diagnosis("damper", fmu, str(test.path), verdict, (ranking[0].effect,) if verdict is Verdict.EXPLAINED else (),
                   explained_below, gap, tuple(ranking), (),
                   NominalFit({n: nominal_fit.params[n] for n in nominal_fit.free}, nominal_fit.calibration_error,
-                             nominal_fit.evaluations),
+                             nominal_fit.evaluations, dict(nominal_fit.params)),
                   tuple(v.level for v in gap.by_level if not v.held_out),
                   tuple(v.level for v in gap.by_level if v.held_out))
     models = {"nominal": z_nom}

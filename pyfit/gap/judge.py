@@ -121,7 +121,8 @@ def ranking(j: Judged, reference: float, explained_below: float, band: Predictio
             kept=len(members) == 1 or name == j.selected, screening_explained=j.screening.get(name),
             wall_s=fit.wall_s, from_envelopes=fit.from_envelopes,
             member_shares_pct=selection.member_shares(list(members), by_members.get) if len(members) > 1 else None,
-            prediction_band=dataclasses.asdict(band) if in_band else None, explains_in_band=inside if in_band else None))
+            prediction_band=dataclasses.asdict(band) if in_band else None, explains_in_band=inside if in_band else None,
+            values=dict(fit.params)))
     out.sort(key=lambda d: (not d.kept, not d.explains, d.effect != j.selected, -d.score))
     return out
 
@@ -177,7 +178,8 @@ def assemble(system, cfg, records, cal, held, nominal, fits, sims, screening, ba
         model=system.name, fmu=system.fmu, source="", verdict=found,
         chosen=best.members if found is Verdict.EXPLAINED else (), explained_below=explained_below, gap=gap,
         ranking=tuple(ranked), evidence=tuple(lines),
-        nominal=NominalFit(free_values(nominal, ()), nominal.calibration_nrmse, nominal.evaluations),
+        nominal=NominalFit(free_values(nominal, ()), nominal.calibration_nrmse, nominal.evaluations,
+                           dict(nominal.params)),
         calibration_files=tuple(r.name for r in cal), held_out_files=tuple(r.name for r in held),
         runner_up_close=bool(len(ranked) > 1 and gap.significant
                              and ranked[0].score - ranked[1].score < cfg.close_points),

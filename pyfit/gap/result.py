@@ -105,15 +105,18 @@ class ModelFit:
     member_shares_pct: dict | None = None
     prediction_band: dict | None = None
     explains_in_band: bool | None = None
+    values: dict = dataclasses.field(default_factory=dict)  # every FMU parameter the model sets (SI): to simulate it
 
 
 @dataclass(frozen=True)
 class NominalFit:
-    """The calibrated nominal model: its free parameters (SI), calibration misfit and evaluations."""
+    """The calibrated nominal model: its free parameters (SI), calibration misfit and evaluations, and every FMU
+    parameter it sets."""
 
     params: dict
     calibration_nrmse: float
     evaluations: int
+    values: dict = dataclasses.field(default_factory=dict)
 
 
 @dataclass(frozen=True)
