@@ -182,11 +182,12 @@ def test_the_headline_states_the_size_range_the_summary_was_drawn_at(tmp_path):
     lo, hi = sizing.SIZE_RANGE
     line = generated._campaign_headline(tmp_path)
     assert f"each at {lo:g}–{hi:g} × the sensor noise" in line and "in 100 %" in line
-    # the damper campaign's line, from its own summary, points to its own section
+    # the damper campaign's line, from its own summary, points to its own page
     (tmp_path / "campaign_damper.md").write_text(text, encoding="utf-8")
     damper = generated._campaign_headline(tmp_path, "campaign_damper.md", "Damper campaign", "catalogue dampers",
-                                          "geometry drawn", "damper-cases", first=False)
-    assert damper.startswith("- **Damper campaign**: on 1 random catalogue dampers") and "#damper-cases" in damper
+                                          "geometry drawn", "damper-campaigns.md", first=False)
+    assert damper.startswith("- **Damper campaign**: on 1 random catalogue dampers")
+    assert "(../validation/damper-campaigns.md)" in damper
 
 
 def test_the_summary_times_nulls_singles_and_pairs_apart():

@@ -30,7 +30,7 @@ from pyfit.gap import campaign
 from pyfit.gap.systems import FAMILY
 
 def wanted(seed):  # two cases, each withholding the dummy at 5 x the noise or more
-    cases = campaign.draw(2, seed, excitation="multisine")
+    cases = campaign.draw(2, seed, excitation="sweep")
     return all(c.withheld == "stiffening_spring" and c.sizes["stiffening_spring"] >= 5 for c in cases)
 
 seed = next(s for s in range(2000) if wanted(s))
@@ -38,7 +38,7 @@ out, fmus, config = sys.argv[1:4]
 with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as lc, \
         Client(lc) as client:
     summary = campaign.run(2, out, fmus, seed, scheduler=client, progress=False, config=config,
-                           excitation="multisine")
+                           excitation="sweep", record_s=4.0)
 print(json.dumps({"seed": seed, "switched_off": FAMILY["sdof"].switches.get("k3"),
                   "candidate": "stiffening_spring" in FAMILY["sdof"].effects,
                   "top1": summary["top1"], "confusion": summary["confusion"]}))
