@@ -11,7 +11,7 @@ import pytest
 from pyfit.gap import campaign, confidence, datasets, sizing
 from pyfit.gap import diagnose as dg
 from pyfit.report import generated
-from pyfit.gap.effect import Scale
+from pyfit.gap.effect import Scale, with_derived
 from pyfit.gap.effects import DAMPER_LOOP_STARTS, SDOF_LOOP_STARTS, candidates
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -134,7 +134,8 @@ def test_a_folder_holding_another_campaign_s_cases_is_refused_not_read_as_this_o
 def test_no_drawn_loop_sits_at_a_start_of_the_candidate():
     scale = Scale(1e-3, 0.2, 1e5, {})
     effect = candidates("sdof")["hysteresis"]
-    starts = [{p.name: p.range(scale)[1] for p in effect.params}] + effect.starts(scale)
+    starts = [with_derived(s, effect.derived(scale))
+              for s in [{p.name: p.range(scale)[1] for p in effect.params}] + effect.starts(scale)]
     loops = [c.truth for c in campaign.draw(200, seed=4) if "gamma" in c.truth]
     for loop in loops:
         assert all(abs(loop["gamma"] - s["gamma"]) > 1e-6 or abs(loop["delta"] - s["delta"]) > 1e-6 for s in starts)

@@ -97,16 +97,17 @@ def test_a_pair_with_a_loop_descends_from_each_loop_basin_and_so_does_the_loop_b
     the loop alone); attribute.pinned keeps them while the loop's shape is fitted (the loop beside a held spring)
     and drops them once it is held (the spring beside the held loop has no loop basins left)."""
     from pyfit.gap.attribute import FitTask, pinned
-    from pyfit.gap.effect import combine
+    from pyfit.gap.effect import Scale, combine
     from pyfit.gap.effects import candidates, sdof_loop_basin
 
     pair = combine([candidates("sdof")["cubic_stiffness"], candidates("sdof")["hysteresis"]])
     assert pair.basin is sdof_loop_basin and combine([candidates("sdof")["cubic_stiffness"],
                                                       candidates("sdof")["quadratic_damping"]]).basin is None
-    shape = {"gamma": 0.5, "delta": -1.5, "nu": 2.0}
+    shape = {"F_t": 30.0, "branch": -0.5, "nu": 2.0}
+    basin = pair.basin(Scale(1e-3, 0.2, 1e5))
     task = FitTask("x.fmu", (), {"m": 2.0}, {"k": 1e5, "alpha": 1e4, "k3": 0.0, **shape},
-                   {n: (-10.0, 10.0) for n in ("k", "alpha", "k3", *shape)}, pair.name, 2, 120, 1, basin=pair.basin)
-    assert pinned(task, {"k3": 1e8}, 60).basin is sdof_loop_basin
+                   {n: (-10.0, 10.0) for n in ("k", "alpha", "k3", *shape)}, pair.name, 2, 120, 1, basin=basin)
+    assert pinned(task, {"k3": 1e8}, 60).basin is basin
     assert pinned(task, {"alpha": 1e4, **shape}, 60).basin is None
 
 

@@ -10,7 +10,7 @@ import pytest
 from pyfit.gap import campaign, datasets, selection
 from pyfit.gap.result import Diagnosis, Verdict
 from pyfit.gap import diagnose as dg
-from pyfit.gap.effect import Scale
+from pyfit.gap.effect import Scale, with_derived
 from pyfit.gap.effects import candidates
 
 pytestmark = pytest.mark.slow
@@ -43,7 +43,8 @@ def _loop(k: float, nu: float, s: float, d: float, z_y: float) -> dict:
 
 def _starts_hold_none_of(truth: dict, effect) -> bool:
     scale = Scale(1e-3, 0.2, 1e5, {"a1": 0.0325, "a2": 0.0325})
-    starts = [{p.name: p.range(scale)[1] for p in effect.params}] + effect.starts(scale)
+    starts = [with_derived(s, effect.derived(scale))
+              for s in [{p.name: p.range(scale)[1] for p in effect.params}] + effect.starts(scale)]
     return all(any(abs(s.get(k, np.inf) - v) > 1e-9 for k, v in truth.items() if k in s) for s in starts)
 
 

@@ -56,7 +56,7 @@ class FitTask:
     continuation: bool = True  # envelopes first, then the lowest level, then all (see run_fit)
     log_scaled: tuple = ()  # free parameters scaled to their bounds on a log scale (positive, spanning decades)
     floor: dict | None = None  # a point the result must not be worse than (the nominal: the effect at zero)
-    derived: tuple = ()  # rules giving fixed parameters from fitted ones (effect.ExponentScaled)
+    derived: tuple = ()  # rules giving fixed parameters from fitted ones (effect.LoopCoordinates)
     basin: callable = None  # start values -> their basin: refit from the best start of each (a module-level
     # function, so the task pickles to a worker)
     probes: int = 1  # without a basin: the best starts descended before the best of them goes on
@@ -361,7 +361,7 @@ def effect_task(system: System, effect: Effect, fmu: str, records: list, nominal
                    effect.strengths, budget, upsample, system.lead_periods, tuple(alternatives),
                    log_scaled=tuple(p.name for p in effect.params if p.log), floor=floor,
                    derived=effect.derived(scale),
-                   basin=effect.basin)
+                   basin=effect.basin(scale) if effect.basin else None)
 
 
 def screen(system: System, fmu: str, records: list, nominal: Fit, scale: Scale, upsample: int, effects: list,

@@ -156,14 +156,16 @@ def prepare(model: str, data_dir, cfg: DiagnoseConfig, fmu_dir="fmus", nominal: 
 
 def _run_key(p: Prepared, model: str) -> str:
     """The key a run's stored fits are valid for: the data, the settings that change how a fit is made (not how
-    results are judged), the model, its description, the user's candidates and the calibration files."""
+    results are judged), the model, its description, the user's candidates, the candidates' fitted parameters
+    and the calibration files."""
     judging = set(settings_with_role(JUDGING))
     settings = json.dumps({k: v for k, v in asdict(p.cfg).items() if k not in judging}, sort_keys=True)
     described = p.described
     description = json.dumps({"fixed": described.fixed, "free": {k: asdict(v) for k, v in described.free.items()}}
                              if described else {}, sort_keys=True)
     declared = p.users.text + hashlib.sha256(pathlib.Path(p.fmu).read_bytes()).hexdigest() if p.users else ""
-    return hashlib.sha256((p.data.key + settings + model + description + declared
+    coordinates = ";".join(f"{n}:{','.join(q.name for q in e.params)}" for n, e in p.system.effects.items())
+    return hashlib.sha256((p.data.key + settings + model + description + declared + coordinates
                            + ",".join(r.name for r in p.data.cal)).encode()).hexdigest()[:16]
 
 

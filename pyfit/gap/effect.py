@@ -31,23 +31,50 @@ class Param:
     log: bool = False
 
 
-@dataclass(frozen=True)
-class ExponentScaled:
-    """A fixed parameter whose unit depends on a fitted exponent: target = value · reference^(1 − exponent).
-    The SDOF Bouc-Wen β [m⁻¹·N^(1−ν)] (theory §1.1): value 1/σ_y and reference the force 0.3·k·σ_y keep
-    β·|z|^ν / α of order one at the data's deflection for every ν, so γ and δ stay of order one."""
+# The §1.1 Bouc-Wen loop's physically named coordinates, fitted in place of β, γ, δ (theory §1.1): not FMU
+# parameters (pyfit.gap.simulate leaves them out), LoopCoordinates gives β, γ, δ from them
+TURNOVER, BRANCH = "F_t", "branch"
+COORDINATES = (TURNOVER, BRANCH)
 
-    target: str
-    value: float
-    reference: float
-    exponent: str
+
+def branch_slopes(branch: float) -> tuple[float, float]:
+    """(s, d) = (γ + δ, γ − δ) of a branch coordinate: the square's edge max(|s|, |d|) = 1 walked from (−1, −1)
+    through (−1, 1) and (1, 1) to (1, −1): (−1, branch + 2) below −1, (branch, 1) up to 1, (1, 2 − branch) above."""
+    if branch < -1.0:
+        return -1.0, branch + 2.0
+    return (branch, 1.0) if branch <= 1.0 else (1.0, 2.0 - branch)
+
+
+def loop_coordinates(alpha: float, beta: float, gamma: float, delta: float, nu: float) -> dict:
+    """The turnover force F_t [N] and branch coordinate of a §1.1 loop given by α [N/m], β, γ, δ, ν (the inverse
+    of LoopCoordinates). ValueError for a linear element (γ = δ = 0) and for the one edge the walk leaves out (an
+    unloading branch that softens at the full rate while the loading one changes less: d = −m, |s| < m)."""
+    s, d = gamma + delta, gamma - delta
+    m = max(abs(s), abs(d))
+    if m == 0.0 or (d / m <= -1.0 + 1e-12 and abs(s) / m < 1.0 - 1e-12):
+        raise ValueError(f"γ = {gamma:g}, δ = {delta:g}: a loop the branch coordinate does not hold")
+    s, d = s / m, d / m
+    branch = s if d >= 1.0 - 1e-12 else (2.0 - d if s > 0 else d - 2.0)
+    return {TURNOVER: (alpha / (beta * m)) ** (1.0 / nu), BRANCH: branch}
+
+
+@dataclass(frozen=True)
+class LoopCoordinates:
+    """β, γ, δ of the §1.1 Bouc-Wen law (FMU parameters) from α, ν and the loop's physically named coordinates:
+    the turnover force F_t [N], at which the more nonlinear branch's tangent has changed by α (a softening
+    loading branch saturates there), and the branch coordinate (branch_slopes): β = α / F_t^ν, γ = (s + d)/2,
+    δ = (s − d)/2. The loading tangent at |z| = F_t is then (1 − s)·α, the unloading one (1 + d)·α."""
 
     def __call__(self, params: dict) -> dict:
-        return {**params, self.target: self.value * self.reference ** (1.0 - params[self.exponent])}
+        if TURNOVER not in params:
+            return params
+        s, d = branch_slopes(params[BRANCH])
+        return {**params, "beta": params["alpha"] / params[TURNOVER] ** params["nu"], "gamma": 0.5 * (s + d),
+                "delta": 0.5 * (s - d)}
 
 
 def with_derived(params: dict, rules: tuple) -> dict:
-    """params with every rule (e.g. ExponentScaled) applied in turn."""
+    """params with every rule (e.g. LoopCoordinates) applied in turn."""
     for rule in rules:
         params = rule(params)
     return params
@@ -68,7 +95,8 @@ class Effect:
     members: tuple = ()  # the single effects of a combination (see `combine`); () for a single effect
     signal_only: bool = False  # acts on the recorded channels, not in the FMU (pyfit.gap.simulate applies it)
     derived: callable = field(default=lambda s: ())  # Scale -> rules giving fixed values from fitted ones
-    basin: callable = None  # start values -> the basin they lie in (the refit descends from each basin's best)
+    # Scale -> a picklable (start values -> the basin they lie in): the refit descends from each basin's best
+    basin: callable = None
     # fitted values -> overrides that keep only the effect's linear part (a loop closed to a spring): what a linear
     # element there buys, where the nominal lacks that freedom ([] where it has it, or the effect has no linear part)
     linear_parts: callable = field(default=lambda params: [])

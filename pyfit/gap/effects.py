@@ -4,10 +4,12 @@ Modelica element (or, for an effect on the recorded channels, its `on_outputs`) 
 Ranges follow the data Scale (SI units)."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from pyfit.analysis.signals import delayed
-from pyfit.gap.effect import Builtin, Effect, ExponentScaled, Param, Scale
+from pyfit.gap.effect import BRANCH, TURNOVER, Builtin, Effect, LoopCoordinates, Param, Scale, loop_coordinates
 
 def _sym(scale_fn):
     return lambda s: (-scale_fn(s), 0.0, scale_fn(s))
@@ -16,6 +18,15 @@ def _sym(scale_fn):
 # the friction's smoothing velocity v_s [m/s] (F = F_c tanh(v / v_s)): from near-ideal Coulomb (1e-3 of the
 # velocity RMS) to a friction that is still rounding off at half of it; started at 1e-2
 _stick_velocity = Param("v_s", lambda s: (1e-3 * s.sigma_v, 1e-2 * s.sigma_v, 0.5 * s.sigma_v), shape=True, log=True)
+
+# The SDOF loop is fitted in physically named coordinates (theory §1.1; effect.LoopCoordinates): α, the turnover
+# force F_t [N] (log-scaled over TURNOVER_RANGE times the spring force k·σ_y at the data's deflection: from a loop
+# that turns over at a few times the noise's force to one stronger than the linear spring), the branch coordinate
+# (effect.branch_slopes: hardening to softening loading, stiffening to elastic unloading) and ν up to MAX_NU. No
+# corner of the family lies beyond a bound a real loop reaches.
+TURNOVER_RANGE = (1e-4, 1e2)
+BRANCH_RANGE = (-2.0, 3.0)
+MAX_NU = 6.0
 
 # Shapes of the Bouc-Wen loop the refit starts from, spanning the family (theory §1.1 and §1.3): with β set
 # to (1/sigma_y)·(0.3·k·sigma_y)^(1-ν) (SDOF) or D to sigma_y (damper), the loading branch softens when
@@ -37,7 +48,7 @@ DAMPER_LOOP_STARTS = ({"a_bw": 0.5, "beta": 0.75, "gamma": 0.25, "nu": 1.0},
                       {"a_bw": 0.7, "beta": 1.0, "gamma": 0.0, "nu": 3.0})
 
 DEFAULT_SHARE = 0.1  # share of the stiffness the hysteretic element holds at small amplitude: the default start
-BETA_SHARE = 0.3  # the share that sets β's scale (ExponentScaled)
+BETA_SHARE = 0.3  # the share that sets the listed shapes' β (_reference_beta)
 # the shares each loop width starts from. As listed (width 1: a loop that saturates within the data's deflection),
 # from a very weak element (0.3 %: a loop whose hysteretic force is a few times the noise's; from 3 % up its refit
 # ends at a nearly linear loop several times as strong) and a weak one (3 %: it saturates early and adds a little
@@ -52,17 +63,46 @@ LOOP_SHARES = {1.0: (0.003, 0.03, DEFAULT_SHARE, 0.3, 0.6), 0.3: (0.003, 0.03, D
 NARROW_FROM = 0.5  # |γ| + |δ| of a loop start from which it counts as narrow (the listed shapes: 1 to 2)
 
 
+def _reference_beta(s: Scale, nu: float) -> float:
+    """The β the listed loop shapes are scaled by: (1/σ_y)·(BETA_SHARE·k·σ_y)^(1−ν), which keeps β·|z|^ν / α of
+    order one at the data's deflection for every ν (a start's γ, δ of order one)."""
+    return (BETA_SHARE * s.k * s.sigma_y) ** (1.0 - nu) / s.sigma_y
+
+
+def _sdof_loop(s: Scale, share: float, width: float, shape: dict) -> dict:
+    """A loop start: the hysteretic element holding `share` of the calibrated stiffness (k + α = the nominal k),
+    a listed shape (γ, δ, ν) with γ, δ times `width` at the reference β, in the fitted coordinates."""
+    alpha = share * s.k
+    return {"k": (1.0 - share) * s.k, "alpha": alpha, "nu": shape["nu"],
+            **loop_coordinates(alpha, _reference_beta(s, shape["nu"]), width * shape["gamma"],
+                               width * shape["delta"], shape["nu"])}
+
+
 def _sdof_loop_starts(s: Scale) -> list[dict]:
-    """Every loop shape at every width and each of its hysteretic shares of the calibrated stiffness (k + alpha =
-    the nominal k), but the default start (the first shape, as listed, at the default share)."""
-    return [{"k": (1.0 - f) * s.k, "alpha": f * s.k, **{n: v * w if n != "nu" else v for n, v in shape.items()}}
-            for w, shares in LOOP_SHARES.items() for f in shares for shape in SDOF_LOOP_STARTS
-            if (w, f, shape) != (1.0, DEFAULT_SHARE, SDOF_LOOP_STARTS[0])]
+    """Every loop shape at every width and each of its hysteretic shares of the calibrated stiffness, but the
+    default start (the first shape, as listed, at the default share)."""
+    return [_sdof_loop(s, f, w, shape) for w, shares in LOOP_SHARES.items() for f in shares
+            for shape in SDOF_LOOP_STARTS if (w, f, shape) != (1.0, DEFAULT_SHARE, SDOF_LOOP_STARTS[0])]
 
 
-def sdof_loop_basin(values: dict) -> tuple:
-    """The basin an SDOF loop start lies in: its ν (β's scale follows ν) and whether it is narrow or wide."""
-    return round(values["nu"], 6), abs(values["gamma"]) + abs(values["delta"]) >= NARROW_FROM
+@dataclass(frozen=True)
+class SdofLoopBasin:
+    """The basin an SDOF loop start lies in: its ν and whether it is narrow (|γ| + |δ| ≥ NARROW_FROM at the
+    reference β of the data's deflection `sigma_y` [m] and stiffness `k` [N/m]) or wide. Picklable: a refit task
+    carries it to a worker."""
+
+    sigma_y: float
+    k: float
+
+    def __call__(self, values: dict) -> tuple:
+        nu = values["nu"]
+        reach = values["alpha"] / (_reference_beta(Scale(self.sigma_y, 0.0, self.k), nu) * values[TURNOVER] ** nu)
+        return round(nu, 6), reach >= NARROW_FROM
+
+
+def sdof_loop_basin(s: Scale) -> SdofLoopBasin:
+    """The SDOF loop's basins at the data scale `s`."""
+    return SdofLoopBasin(s.sigma_y, s.k)
 
 
 # Strengths of the cubic spring the refit starts from, as the share k3·σ_y²/k of the linear stiffness it adds at
@@ -161,10 +201,13 @@ SDOF = {b.name: b for b in (
     Builtin(Effect(
         "hysteresis",
         (Param("alpha", lambda s: (0.0, DEFAULT_SHARE * s.k, 2.0 * s.k)),
-         Param("gamma", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["gamma"], 5.0)),
-         Param("delta", shape=True, range=lambda s: (-5.0, SDOF_LOOP_STARTS[0]["delta"], 5.0)),
-         Param("nu", shape=True, range=lambda s: (1.0, SDOF_LOOP_STARTS[0]["nu"], 3.0))),
-        derived=lambda s: (ExponentScaled("beta", 1.0 / s.sigma_y, BETA_SHARE * s.k * s.sigma_y, "nu"),),
+         Param(TURNOVER, shape=True, log=True, range=lambda s: (
+             TURNOVER_RANGE[0] * s.k * s.sigma_y, _sdof_loop(s, DEFAULT_SHARE, 1.0, SDOF_LOOP_STARTS[0])[TURNOVER],
+             TURNOVER_RANGE[1] * s.k * s.sigma_y)),
+         Param(BRANCH, shape=True, range=lambda s: (BRANCH_RANGE[0], _sdof_loop(
+             s, DEFAULT_SHARE, 1.0, SDOF_LOOP_STARTS[0])[BRANCH], BRANCH_RANGE[1])),
+         Param("nu", shape=True, range=lambda s: (1.0, SDOF_LOOP_STARTS[0]["nu"], MAX_NU))),
+        derived=lambda s: (LoopCoordinates(),),
         basin=sdof_loop_basin,
         signature="amplitude-dependent stiffness and damping (hysteresis loops), odd distortion",
         shift_stiffness=0.1, starts=lambda s: _sdof_loop_starts(s)),

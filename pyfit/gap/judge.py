@@ -10,6 +10,7 @@ import numpy as np
 from pyfit.gap import evidence, localise, selection
 from pyfit.gap import simulate as sim
 from pyfit.gap.band import PredictionBand
+from pyfit.gap.effect import TURNOVER
 from pyfit.gap.result import BandMisfit, Diagnosis, Gap, LevelMisfit, ModelFit, NominalFit, Separation, Verdict
 
 
@@ -77,13 +78,11 @@ def best_refit(fits: dict) -> tuple[float, str]:
 
 
 def free_values(fit, members) -> dict:
-    """A fit's free parameter values (SI); with the SDOF loop (`members` holding 'hysteresis' with δ free) also β
-    and the identifiable products β·γ and β·δ."""
+    """A fit's free parameter values (SI); with the SDOF loop's coordinates free (effect.LoopCoordinates) also the
+    Bouc-Wen β, γ, δ they give."""
     out = {n: fit.params[n] for n in fit.free}
-    if "hysteresis" in members and "delta" in fit.free:
-        out["beta (set by nu)"] = fit.params["beta"]
-        out["beta*gamma"] = fit.params["beta"] * fit.params["gamma"]
-        out["beta*delta"] = fit.params["beta"] * fit.params["delta"]
+    if TURNOVER in fit.free:
+        out.update({n: fit.params[n] for n in ("beta", "gamma", "delta")})
     return out
 
 

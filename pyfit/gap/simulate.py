@@ -12,6 +12,7 @@ import numpy as np
 from pyfit.analysis import kinematics
 from pyfit.analysis.kinematics import ORDER
 from pyfit.analysis.signals import high_passed, without_offset
+from pyfit.gap.effect import COORDINATES
 from pyfit.gap.effects import output_effects
 from pyfit.io.data import Measurement
 from pyfit.runtime.fmu import FmuRunner
@@ -184,8 +185,8 @@ def simulate(runner: FmuRunner, rec: Record, params: dict, upsample: int = 4, le
     (pyfit.runtime.drive), to time it."""
     if tolerance is None:
         tolerance = tolerance_of(rec)
-    on_outputs = {n: params[n] for n in ON_OUTPUTS if n in params}  # not FMU parameters
-    params = {n: v for n, v in params.items() if n not in on_outputs}
+    on_outputs = {n: params[n] for n in ON_OUTPUTS if n in params}  # not FMU parameters, nor are the coordinates
+    params = {n: v for n, v in params.items() if n not in on_outputs and n not in COORDINATES}
     inputs, repeat = rec.inputs, 1
     rigid = None
     if rec.support:  # from rest relative to the support: its start moved to rest, the outputs moved back
