@@ -16,14 +16,16 @@ def test_a_few_starts_are_written_one_by_one():
 
 def test_many_starts_are_summarised_by_parameter():
     """The SDOF loop's starts (more than LISTED_IN_FULL): ν's three values, the five hysteretic shares of
-    k = 1e5 N/m, γ's range from the widest loop's to the largest listed γ, and where the full list is."""
+    k = 1e5 N/m, the turnover forces' range (at σ_y = 1 mm and ν = 1 F_t = α·σ_y / (width·(|γ| + |δ|)): from the
+    weakest element's narrowest loop, 300 N/m·1 mm / 2, to the strongest's widest, 60000 N/m·1 mm / 0.01), the
+    five listed branch shapes and where the full list is."""
     scale = Scale(1e-3, 0.2, 1e5, {})
     starts = candidates("sdof")["hysteresis"].starts(scale)
     assert len(starts) > LISTED_IN_FULL
     text = starts_text(starts)
     assert "nu in {1, 2, 3}" in text
     assert "alpha in {300, 3000, 10000, 30000, 60000}" in text
-    assert "gamma from 0.0025 to 1.5 (" in text
+    assert "F_t from 0.15 to 6000 (" in text and "branch in {-0.5, 0.5, 1, 2, 2.5}" in text
     assert text.endswith("(each start in report.json, `listed_starts`)")
 
 

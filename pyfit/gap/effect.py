@@ -31,30 +31,44 @@ class Param:
     log: bool = False
 
 
-# The §1.1 Bouc-Wen loop's physically named coordinates, fitted in place of β, γ, δ (theory §1.1): not FMU
-# parameters (pyfit.gap.simulate leaves them out), LoopCoordinates gives β, γ, δ from them
+# A Bouc-Wen loop's physically named coordinates (theory §1.1, §1.3), fitted in place of its shape coefficients:
+# the turnover force F_t [N] of the §1.1 form and the branch coordinate of both forms. Not FMU parameters
+# (pyfit.gap.simulate leaves them out): LoopCoordinates and BranchCoordinate give the coefficients from them
 TURNOVER, BRANCH = "F_t", "branch"
 COORDINATES = (TURNOVER, BRANCH)
 
 
 def branch_slopes(branch: float) -> tuple[float, float]:
-    """(s, d) = (γ + δ, γ − δ) of a branch coordinate: the square's edge max(|s|, |d|) = 1 walked from (−1, −1)
-    through (−1, 1) and (1, 1) to (1, −1): (−1, branch + 2) below −1, (branch, 1) up to 1, (1, 2 − branch) above."""
+    """(s, d) of a branch coordinate, s the loading branch's softening coefficient and d the unloading branch's
+    stiffening one (§1.1: γ + δ and γ − δ; §1.3: β + γ and β − γ): the square's edge max(|s|, |d|) = 1 walked
+    from (−1, −1) through (−1, 1) and (1, 1) to (1, −1): (−1, branch + 2) below −1, (branch, 1) up to 1,
+    (1, 2 − branch) above."""
     if branch < -1.0:
         return -1.0, branch + 2.0
     return (branch, 1.0) if branch <= 1.0 else (1.0, 2.0 - branch)
 
 
-def loop_coordinates(alpha: float, beta: float, gamma: float, delta: float, nu: float) -> dict:
-    """The turnover force F_t [N] and branch coordinate of a §1.1 loop given by α [N/m], β, γ, δ, ν (the inverse
-    of LoopCoordinates). ValueError for a linear element (γ = δ = 0) and for the one edge the walk leaves out (an
-    unloading branch that softens at the full rate while the loading one changes less: d = −m, |s| < m)."""
-    s, d = gamma + delta, gamma - delta
+def branch_of(s: float, d: float) -> tuple[float, float]:
+    """The branch coordinate of the slopes (s, d) and their scale max(|s|, |d|) (the inverse of branch_slopes).
+    ValueError for a linear element (s = d = 0) and for the one edge the walk leaves out (an unloading branch
+    that softens at the full rate while the loading one changes less: d = −m, |s| < m)."""
     m = max(abs(s), abs(d))
     if m == 0.0 or (d / m <= -1.0 + 1e-12 and abs(s) / m < 1.0 - 1e-12):
-        raise ValueError(f"γ = {gamma:g}, δ = {delta:g}: a loop the branch coordinate does not hold")
+        raise ValueError(f"loading slope {s:g}, unloading slope {d:g}: a loop the branch coordinate does not hold")
     s, d = s / m, d / m
-    branch = s if d >= 1.0 - 1e-12 else (2.0 - d if s > 0 else d - 2.0)
+    return (s if d >= 1.0 - 1e-12 else (2.0 - d if s > 0 else d - 2.0)), m
+
+
+def _odd_even(branch: float) -> tuple[float, float]:
+    """The law's coefficients of |v|·|z|^(ν−1)·z and of v·|z|^ν at a branch coordinate: ((s + d)/2, (s − d)/2)."""
+    s, d = branch_slopes(branch)
+    return 0.5 * (s + d), 0.5 * (s - d)
+
+
+def loop_coordinates(alpha: float, beta: float, gamma: float, delta: float, nu: float) -> dict:
+    """The turnover force F_t [N] and branch coordinate of a §1.1 loop given by α [N/m], β, γ, δ, ν (the inverse
+    of LoopCoordinates; ValueError as branch_of)."""
+    branch, m = branch_of(gamma + delta, gamma - delta)
     return {TURNOVER: (alpha / (beta * m)) ** (1.0 / nu), BRANCH: branch}
 
 
@@ -68,9 +82,21 @@ class LoopCoordinates:
     def __call__(self, params: dict) -> dict:
         if TURNOVER not in params:
             return params
-        s, d = branch_slopes(params[BRANCH])
-        return {**params, "beta": params["alpha"] / params[TURNOVER] ** params["nu"], "gamma": 0.5 * (s + d),
-                "delta": 0.5 * (s - d)}
+        gamma, delta = _odd_even(params[BRANCH])
+        return {**params, "beta": params["alpha"] / params[TURNOVER] ** params["nu"], "gamma": gamma,
+                "delta": delta}
+
+
+@dataclass(frozen=True)
+class BranchCoordinate:
+    """β, γ of the §1.3 (normalised) Bouc-Wen law from the branch coordinate: (s + d)/2 and (s − d)/2 with
+    max(|s|, |d|) = 1, so that z turns over near 1 and the fitted D [m] is the deflection the loop turns over at."""
+
+    def __call__(self, params: dict) -> dict:
+        if BRANCH not in params:
+            return params
+        beta, gamma = _odd_even(params[BRANCH])
+        return {**params, "beta": beta, "gamma": gamma}
 
 
 def with_derived(params: dict, rules: tuple) -> dict:

@@ -9,7 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pyfit.analysis.signals import delayed
-from pyfit.gap.effect import BRANCH, TURNOVER, Builtin, Effect, LoopCoordinates, Param, Scale, loop_coordinates
+from pyfit.gap.effect import (BRANCH, TURNOVER, BranchCoordinate, Builtin, Effect, LoopCoordinates, Param, Scale,
+                              branch_of, loop_coordinates)
 
 def _sym(scale_fn):
     return lambda s: (-scale_fn(s), 0.0, scale_fn(s))
@@ -252,6 +253,13 @@ def _damper_loop_shape(rng) -> dict:
                 nu=rng.uniform(1.0, 2.5), D=rng.uniform(1.5e-4, 4e-4))
 
 
+def _damper_loop(s: Scale, start: dict) -> dict:
+    """A listed damper loop shape (a_bw, β, γ, ν at D = σ_y) in the fitted coordinates: the same loop with its
+    β, γ scaled to the branch coordinate's edge and D to the deflection it then turns over at."""
+    branch, m = branch_of(start["beta"] + start["gamma"], start["beta"] - start["gamma"])
+    return {"a_bw": start["a_bw"], "D": s.sigma_y * m ** (-1.0 / start["nu"]), BRANCH: branch, "nu": start["nu"]}
+
+
 def _damper(effect: Effect, truth: dict, strengths: tuple, shape=None) -> Builtin:
     """A damper effect on both arms: switched off (and reduced to its tangent) at zero strength."""
     off = dict.fromkeys(strengths, 0.0)
@@ -260,15 +268,18 @@ def _damper(effect: Effect, truth: dict, strengths: tuple, shape=None) -> Builti
 
 
 DAMPER = {b.name: b for b in (
-    _damper(Effect(  # A = 1 and D = sigma_y: only β D^-ν, γ D^-ν (with ν) are identifiable (theory §1.3)
+    _damper(Effect(  # A = 1; β, γ from the branch coordinate, D the deflection the loop turns over at (theory §1.3)
         "hysteresis", _pair("k_bw1", "k_bw2", lambda s: (0.0, 0.05 * s.k, 0.5 * s.k))
         + (Param("a_bw", shape=True, range=lambda s: (0.0, DAMPER_LOOP_STARTS[0]["a_bw"], 1.0)),
-           Param("beta", shape=True, range=lambda s: (0.0, DAMPER_LOOP_STARTS[0]["beta"], 5.0)),
-           Param("gamma", shape=True, range=lambda s: (-5.0, DAMPER_LOOP_STARTS[0]["gamma"], 5.0)),
-           Param("nu", shape=True, range=lambda s: (1.0, DAMPER_LOOP_STARTS[0]["nu"], 3.0))),
-        fixed=lambda s: {"A": 1.0, "D": s.sigma_y},
+           Param("D", shape=True, log=True, range=lambda s: (
+               TURNOVER_RANGE[0] * s.sigma_y, _damper_loop(s, DAMPER_LOOP_STARTS[0])["D"],
+               TURNOVER_RANGE[1] * s.sigma_y)),
+           Param(BRANCH, shape=True, range=lambda s: (-1.0, _damper_loop(s, DAMPER_LOOP_STARTS[0])[BRANCH],
+                                                      BRANCH_RANGE[1])),
+           Param("nu", shape=True, range=lambda s: (1.0, DAMPER_LOOP_STARTS[0]["nu"], MAX_NU))),
+        fixed=lambda s: {"A": 1.0}, derived=lambda s: (BranchCoordinate(),),
         signature="amplitude-dependent stiffness and damping of the cable (hysteresis loops), odd distortion",
-        starts=lambda s: [dict(st) for st in DAMPER_LOOP_STARTS[1:]],
+        starts=lambda s: [_damper_loop(s, st) for st in DAMPER_LOOP_STARTS[1:]],
         # the nominal has one EI for both arms: a loop's linear part, a stiffness per arm, is a freedom it lacks (the
         # SDOF's k holds an SDOF loop's); closed to a spring of its stiffness before and after yield
         linear_parts=lambda p: [{"a_bw": 1.0}, {"a_bw": 1.0, "k_bw1": p["a_bw"] * p["k_bw1"],

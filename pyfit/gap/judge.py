@@ -10,7 +10,7 @@ import numpy as np
 from pyfit.gap import evidence, localise, selection
 from pyfit.gap import simulate as sim
 from pyfit.gap.band import PredictionBand
-from pyfit.gap.effect import TURNOVER
+from pyfit.gap.effect import BRANCH
 from pyfit.gap.result import BandMisfit, Diagnosis, Gap, LevelMisfit, ModelFit, NominalFit, Separation, Verdict
 
 
@@ -78,11 +78,11 @@ def best_refit(fits: dict) -> tuple[float, str]:
 
 
 def free_values(fit, members) -> dict:
-    """A fit's free parameter values (SI); with the SDOF loop's coordinates free (effect.LoopCoordinates) also the
-    Bouc-Wen β, γ, δ they give."""
+    """A fit's free parameter values (SI); with a loop's coordinates free (effect.LoopCoordinates,
+    BranchCoordinate) also the Bouc-Wen coefficients they give."""
     out = {n: fit.params[n] for n in fit.free}
-    if TURNOVER in fit.free:
-        out.update({n: fit.params[n] for n in ("beta", "gamma", "delta")})
+    if BRANCH in fit.free:
+        out.update({n: fit.params[n] for n in ("beta", "gamma", "delta") if n in fit.params})
     return out
 
 
