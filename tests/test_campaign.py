@@ -278,6 +278,33 @@ def test_the_summary_tells_misses_the_data_cannot_decide_from_misses_of_the_sear
             "a full run takes at most 96.0 min)") in text
 
 
+def test_the_summary_tabulates_the_follow_ups_verdicts_before_and_after():
+    """A campaign run with --follow-up: top-1 and false alarms before and after one follow-up test, the misses for
+    want of evidence (undetected, undecided) named right after it, the tests' mean length; a case without a
+    proposal keeps its verdict."""
+    def outcome(withheld, named, verdict, named_held, truth_held, after=None, test_s=20.0):
+        follow = {"named": after, "verdict": "gap explained", "test_s": test_s} if after else None
+        return {"withheld": withheld, "named": named, "verdict": verdict, "named_held_out": named_held,
+                "truth_held_out": truth_held, "explained_below": 0.012, "enr": 5.0, "top_shrink_pct": None,
+                "stated": None, "data_s": 1.0, "diagnose_s": 1.0, "follow_up": follow}
+    outcomes = [outcome("cubic_stiffness", "none", "no significant gap", 0.007, 0.006, "cubic_stiffness", 10.0),
+                outcome("hysteresis", "cubic_stiffness", "gap explained", 0.005, 0.006, "hysteresis", 30.0),
+                outcome("coulomb_friction", "none", "no significant gap", 0.007, 0.006, "none", 20.0),  # not found
+                outcome("quadratic_damping", "quadratic_damping", "gap explained", 0.005, 0.005),  # decisive
+                outcome("none", "none", "no significant gap", 0.005, 0.006, "quadratic_damping", 40.0)]  # an alarm
+    s = campaign.summarise(outcomes)["follow_up"]
+    assert s == {"cases": 5, "proposed": 4, "effect_cases": 4, "top1_before": 1, "top1_after": 3, "wanting": 3,
+                 "wanting_proposed": 3, "wanting_right_after": 2, "null_cases": 1, "false_alarms_before": 0,
+                 "false_alarms_after": 1, "mean_test_s": 25.0}
+    text = campaign.markdown({**campaign.summarise(outcomes), "cases": 5, "seed": 0, "record_s": 6.0,
+                              "where": "here", "wall_s": 60.0, "command": "c"})
+    assert "| named right (cases with a withheld effect) | 1 of 4 (25 %) | 3 of 4 (75 %) |" in text
+    assert "named right | 0 of 3 | 2 of 3 (67 %) (3 proposed a test) |" in text
+    assert "Tests proposed: 4 of 5 cases; mean test length 25 s." in text
+    without = [{k: v for k, v in o.items() if k != "follow_up"} for o in outcomes]  # a campaign without them
+    assert campaign.summarise(without)["follow_up"] is None
+
+
 def test_a_resumed_or_extended_campaign_states_the_earlier_runs_wall_time():
     """campaign.wall_of_runs: a run that read cases from an earlier run states that run's wall time beside its own
     when the earlier run covered the same cases or exactly the ones read (a campaign of 20 cases extended to 40 of

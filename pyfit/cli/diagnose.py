@@ -66,6 +66,9 @@ def add_arguments(ap) -> None:
                     "write and diagnose each, summarise (confusion matrix, detection limit, false alarms) in "
                     "OUT/summary.md; resumes")
     ap.add_argument("--campaign-seed", type=int, default=0, help="with --campaign: the draw's seed")
+    ap.add_argument("--follow-up", action="store_true", help="with --campaign: each case whose report is not "
+                    "decisive runs the test the report proposes on its truth and is diagnosed again; the summary "
+                    "gives the verdicts before and after and the tests' length")
     ap.add_argument("--calibrate", action="store_true", help="with --campaign: its hit rates become the confidence "
                     "every later report of the same --model with the same settings (--config) states (stored in the "
                     "package: pyfit/gap/calibration.json, one calibration per family and set of settings)")
@@ -96,7 +99,7 @@ def run(args, ap) -> int:
         if args.campaign:
             campaign.run(args.campaign, args.out, args.fmus, args.campaign_seed, args.workers or 2, args.scheduler,
                          args.record_s or campaign.RECORD_S, calibrate=args.calibrate, model=args.model,
-                         config=args.config, excitation=args.excitation)
+                         config=args.config, excitation=args.excitation, follow=args.follow_up)
             print((pathlib.Path(args.out) / "summary.md").read_text())
             return 0
         cfg = load_config(args.config) if args.config else None

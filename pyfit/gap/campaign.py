@@ -32,6 +32,8 @@ import numpy as np
 
 from pyfit.gap import confidence, datasets, selection, sizing
 from pyfit.gap.diagnose import DiagnoseConfig, diagnose, load_config, misfit_at
+from pyfit.gap import follow_up as follow_ups
+from pyfit.gap.follow_up import follow_up
 from pyfit.gap.result import Verdict
 from pyfit.gap.effects import BUILTINS, drawn
 from pyfit.gap.systems import FAMILY
@@ -136,6 +138,7 @@ class CaseJob:
     fmu_dir: str
     record_s: float
     cfg: DiagnoseConfig = field(default_factory=DiagnoseConfig)  # the diagnosis's settings
+    follow_up: bool = False  # run the test a report that is not decisive proposes, and diagnose again
 
 
 def write_case(c: Case, out: pathlib.Path, record_s: float = RECORD_S) -> tuple[Case, pathlib.Path,
@@ -189,6 +192,8 @@ def run_case(job: CaseJob) -> dict:
         outcome.update(truth_held_out=at_truth.held_out, truth_calibration=at_truth.calibration,
                        named_held_out=named, noise_floor=rep.gap.noise_floor, explained_below=rep.explained_below,
                        **truth_test(rep.gap.overall, rep.gap.shrink_reference, at_truth.held_out, job.cfg))
+        if job.follow_up:
+            outcome["follow_up"] = follow_up(folder, c, data, job.cfg, job.fmu_dir, described)
     except Exception as exc:  # a case that breaks the diagnosis is an outcome of the campaign, not its end
         outcome = {"named": "error", "verdict": f"{type(exc).__name__}: {exc}", "enr": None, "top_shrink_pct": None,
                    "stated": None}
@@ -231,24 +236,26 @@ def stated_with(outcome: dict, calibration: dict | None) -> float | None:
 
 
 def command(n: int, seed: int, model: str = "sdof", config: str | None = None, excitation: str | None = None,
-            record_s: float = RECORD_S) -> str:
+            record_s: float = RECORD_S, follow: bool = False) -> str:
     """The command line that runs this campaign."""
     return (f"stockbridge diagnose --campaign {n} --campaign-seed {seed}" + ("" if model == "sdof" else
                                                                             f" --model {model}")
             + (f" --excitation {excitation}" if excitation else "")
             + (f" --record-s {record_s:g}" if record_s != RECORD_S else "")
-            + (f" --config {config}" if config else ""))
+            + (f" --config {config}" if config else "") + (" --follow-up" if follow else ""))
 
 
 def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=None, record_s: float = RECORD_S,
         progress: bool = True, calibrate: bool = False, model: str = "sdof", config: str | None = None,
-        excitation: str | None = None) -> dict:
+        excitation: str | None = None, follow: bool = False) -> dict:
     """Draw n cases of `model` (every one under `excitation` when given: draw) and diagnose them: on `scheduler`
     (a Dask scheduler address) when given, else on a Dask LocalCluster of `workers` single-threaded processes.
     Writes OUT/summary.md and OUT/summary.json (a campaign whose every case is stored is summarised again, with
     the wall time of the run that diagnosed them: wall_of_runs); with `calibrate`, its hit rates become the
     package's confidence calibration of `model` with its settings (pyfit.gap.confidence), and the summary states
-    every report's confidence with it (in-sample); `config`: a TOML file of diagnosis settings (pyfit.gap.diagnose.load_config; default: the defaults)."""
+    every report's confidence with it (in-sample); `config`: a TOML file of diagnosis settings (pyfit.gap.diagnose.load_config; default: the defaults); with `follow`, each
+    case whose report is not decisive runs the test it proposes on the truth and is diagnosed again
+    (pyfit.gap.follow_up)."""
     if calibrate and excitation:
         raise ValueError("--calibrate takes a campaign of every excitation (a report's confidence is read from it "
                          "whatever its records); drop --excitation")
@@ -260,7 +267,7 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     cfg = load_config(config) if config else DiagnoseConfig()
     settings = confidence.settings_of(asdict(cfg))
     stated_from = confidence.load(settings, model)
-    jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg) for c in cases]
+    jobs = [CaseJob(c, str(out), str(fmu_dir), record_s, cfg, follow) for c in cases]
     # cases an earlier run finished (interrupted, or a rerun of only some cases): read, not diagnosed again, so this
     # run's wall time does not cover them
     stored = [out / f"case{c.index:04d}" / "outcome.json" for c in cases]
@@ -283,7 +290,7 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     earlier = json.loads(before.read_text()) if resumed and before.is_file() else None
     run_by = wall_of_runs({"wall_s": time.perf_counter() - t0, "resumed": resumed, "where": where}, n, earlier)
     if calibrate:
-        stated_from = confidence.calibration_of(outcomes, command(n, seed, model, config, excitation, record_s),
+        stated_from = confidence.calibration_of(outcomes, command(n, seed, model, config, excitation, record_s, follow),
                                                 seed, settings, model)
         confidence.write(stated_from)
     # every report's confidence as stated with the calibration this run reads or writes (an outcome read from an
@@ -291,7 +298,7 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     outcomes = [{**o, "stated": stated_with(o, stated_from)} for o in outcomes]
     summary = summarise(outcomes)
     summary.update({"cases": n, "seed": seed, "record_s": record_s, "excitation": excitation, **run_by,
-                    "command": command(n, seed, model, config, excitation, record_s),
+                    "command": command(n, seed, model, config, excitation, record_s, follow),
                     "model": model,
                     "stated_from": {k: stated_from[k] for k in ("source", "seed", "cases")} if stated_from else None})
     (out / "summary.json").write_text(json.dumps({**summary, "outcomes": outcomes}, indent=1, default=float))
@@ -415,7 +422,8 @@ def summarise(outcomes: list[dict]) -> dict:
             "by_shrink": calibration["by_shrink"], "no_gap": calibration["no_gap"], "check": confidence.check(outcomes),
             "errors": sum(o["named"] == "error" for o in outcomes),
             "median_case_s": _median([o["data_s"] + o["diagnose_s"] for o in fresh]),
-            "times": times_by_kind(outcomes), "fits_reused": len(outcomes) - len(fresh)}
+            "times": times_by_kind(outcomes), "fits_reused": len(outcomes) - len(fresh),
+            "follow_up": follow_ups.summary(outcomes, _miss_cause)}
 
 
 def _share(part: int, whole: int) -> str:
@@ -424,8 +432,8 @@ def _share(part: int, whole: int) -> str:
 
 def markdown(s: dict) -> str:
     """The campaign summary as Markdown."""
-    lines = _headline_lines(s) + _confusion_lines(s) + _size_lines(s) + _miss_lines(s) + _time_lines(s) \
-        + _calibration_lines(s)
+    lines = _headline_lines(s) + _confusion_lines(s) + _size_lines(s) + _miss_lines(s) \
+        + follow_ups.lines(s.get("follow_up")) + _time_lines(s) + _calibration_lines(s)
     return "\n".join(lines) + "\n"
 
 

@@ -11,6 +11,7 @@ trailing period (filter edge) are dropped, so each file holds steady-state perio
 """
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import pathlib
@@ -268,6 +269,47 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
                                                 "member_to_noise": {e: float(np.sqrt(v / channels))
                                                                     for e, v in member_sq.items()}}, indent=1))
     return out
+
+
+def write_test(data_dir, family: Family, signal, stop_s: float, kind: str, level: float, name: str,
+               seed: int) -> pathlib.Path:
+    """One more record of the case write_dataset wrote into `data_dir` (its truth.json: the truth and how it was
+    recorded): the same truth driven by `signal` (a force [N] or a clamp motion [m]) from rest for `stop_s` s,
+    through the same sensor chain (outputs, anti-alias filter and decimation, channel skew; noise drawn with
+    `seed`), written as `name`.csv with its sidecar; `kind` ('sweep' or 'stepped_sine') and the amplitude `level`
+    [N, or m/s for a clamp] are the sidecar's excitation. E.g. the test a report proposes (pyfit.gap.proposal)."""
+    out = pathlib.Path(data_dir)
+    meta = json.loads((out / "truth.json").read_text())
+    truth, style = meta["params"], meta["style"]
+    recorded = tuple(style["outputs"] or family.outputs)
+    physical = {k: v for k, v in truth.items() if k != "sensor_delay"}
+
+    def simulated(params):
+        return _truth(SyntheticSpec(family.model, signal, stop_s, family.fs, list(recorded), params,
+                                    oversample=OVERSAMPLE, rtol=TRUTH_RTOL, atol=TRUTH_ATOL))
+
+    t, exact, _ = simulated(physical)
+    keep = slice(0, int(round(stop_s * family.fs)))
+    clean = simulated({**physical, **family.tangent})[1]  # the noise of a non-displacement output: write_dataset's
+    tk, rng = t[keep] - t[keep][0], np.random.default_rng(seed)
+    inputs = _recorded_inputs(family, kind, signal, t[keep] + truth.get("sensor_delay", 0.0), style["motion"])
+    outputs = {f"{o}_meas": (exact[o][keep] + rng.normal(0.0, _noise_of(family, o, clean[o][keep]), len(tk)),
+                             UNITS.get(o, "m"), o) for o in recorded}
+    unit = "m/s" if family.model != "SDOFBoucWen" else "N"
+    path = out / f"{name}.csv"
+    write_measurement(path, family.model, tk, inputs, outputs, level=f"amplitude {level:g} {unit}", level_value=level,
+                      excitation=_excitation_meta(kind, signal, dataclasses.replace(
+                          family, band_hz=_band_of(signal, family)), level, family.samples_per_period, 0),
+                      notes=f"synthetic: the case's truth on a further test (CasADi reference, the same sensor "
+                            f"chain), noise seed {seed}")
+    return path
+
+
+def _band_of(signal, family: Family) -> tuple:
+    """The frequency range [Hz] a sweep or stepped sine covers."""
+    if isinstance(signal, SteppedSine):
+        return min(signal.frequencies), max(signal.frequencies)
+    return signal.f_start, signal.f_end
 
 
 def effect_sizes(family: Family, effect: str, seed: int = 0, periods: int = PERIODS, style: LabStyle = LabStyle(),
