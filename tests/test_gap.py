@@ -73,6 +73,14 @@ def test_close_runner_up_gets_a_level_and_band_to_measure(data_root, fmu_dir):
     assert best["difference_nrmse"] == max(d["difference_nrmse"] for d in sep.levels) > 0
     assert best["band_hz"][0] < best["band_hz"][1]
     assert "score close" in (out / "report.md").read_text()
+    # not decisive: the report names the next test, as `stockbridge plan-test` proposes it from the report
+    from pyfit.gap.proposal import plan_test
+
+    proposed, _ = plan_test(out, cfg, fmu_dir)
+    nt = rep.next_test
+    assert nt.between == sep.between == proposed.between and nt.test == proposed.test.sentence()
+    assert nt.separation == pytest.approx(proposed.separation, rel=1e-9) and nt.separation > 1.0
+    assert f"**Next test: {nt.test}.**" in (out / "report.md").read_text()
 
 
 def test_a_pinned_refit_holds_the_given_values_and_tries_each_remaining_start_once():

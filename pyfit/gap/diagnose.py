@@ -14,7 +14,7 @@ from pyfit.runtime.clock import StageClock
 from pyfit.runtime.fmu import FmuRunner
 from pyfit.runtime.linearize import linear_modes
 from pyfit.runtime.examples import ensure_fmu
-from pyfit.gap import band, confidence, judge, localise, polarity, report, selection, user_candidates
+from pyfit.gap import band, confidence, judge, localise, polarity, proposal, report, selection, user_candidates
 from pyfit.gap import simulate as sim
 from pyfit.gap.attribute import Fit, effect_task, nominal_task, run_fit, screen
 from pyfit.gap.config import JUDGING, DiagnoseConfig, DiagnoseError, load_config, settings_with_role
@@ -285,7 +285,8 @@ def _which(p: Prepared, c: Calibrated, out, key, workers, progress, clock: Stage
 
 def _judged(p: Prepared, c: Calibrated, w: Which, model: str, data_dir, clock: StageClock) -> Diagnosis:
     """The Diagnosis: the judgement (judge.assemble; with the best model's prediction band where it decides), the
-    stated confidence, where two close leaders differ, and what the data were."""
+    stated confidence, where two close leaders differ, the test that would decide where the report is not decisive
+    (proposal.next_test), and what the data were."""
     cfg, sims = p.cfg, {"nominal": c.sims, **w.sims}
     args = (w.system, cfg, c.records, c.cal, c.held, c.nominal, w.fits, sims, w.screening, c.bands, c.scale, w.gap,
             w.selected)
@@ -299,11 +300,16 @@ def _judged(p: Prepared, c: Calibrated, w: Which, model: str, data_dir, clock: S
     calibration = confidence.load(confidence.settings_of(asdict(p.requested)), model)  # of the settings asked for
     stated = confidence.stated(d.verdict.value, d.chosen_name, d.best.shrink_pct if d.best else None, calibration)
     separation = judge.separation(p.runner, d, c.records, w.fits, c.bands, cfg.upsample, w.system.lead_periods)
-    p.runner.close()
     clock.end("verdict")
+    proposed = proposal.next_test(p.runner, d, c.records, cfg.upsample, w.system.lead_periods,
+                                  bool(w.system.motion_inputs))
+    p.runner.close()
+    if proposed:
+        clock.end("next test")
     data = p.data
     return dataclasses.replace(
-        d, source=str(data_dir), confidence=stated, separation=separation, level_order=data.order,
+        d, source=str(data_dir), confidence=stated, separation=separation, next_test=proposed,
+        level_order=data.order,
         set_aside={name: {"period_scatter": s, "lower_floor": f} for name, (s, f) in data.aside.items()},
         voltage_channels=tuple(data.voltages), clipped_channels=data.clipped,
         analysis_rate={**asdict(data.rate), "drive_upsample": cfg.upsample, "recorded_hz": data.recorded_hz},

@@ -12,7 +12,7 @@ import numpy as np
 from pyfit.analysis.excitation import Excitation, SteppedSine, motion_with_derivatives
 from pyfit.gap import localise
 from pyfit.gap import simulate as sim
-from pyfit.gap.result import Diagnosis, Verdict
+from pyfit.gap.result import Diagnosis, NextTest, Verdict
 
 LEVEL_FACTORS = ((0.5, "lowest"), (1.0, "highest"), (1.5, "highest"))  # of the recorded levels: a bench that
 # ran a level can usually run half as much again, and half its lowest; further out, the models only extrapolate
@@ -136,6 +136,14 @@ def propose(runner, d: Diagnosis, params: dict, records, bands, upsample: int, l
         tried.append((plan, separation(a, b, noise)))
     best = max(tried, key=lambda ps: ps[1])
     return Proposal(pair, best[0], best[1], tuple(tried))
+
+
+def next_test(runner, d: Diagnosis, records, upsample: int, lead_periods: int, clamp: bool) -> NextTest | None:
+    """The report's next test (propose, with each ranked model's and the nominal's values and the gap map's
+    bands); None for a decisive report."""
+    params = {**{f.effect: f.values for f in d.ranking}, "nominal": d.nominal.values}
+    pr = propose(runner, d, params, records, [tuple(b.band_hz) for b in d.gap.by_band], upsample, lead_periods, clamp)
+    return None if pr is None else NextTest(pr.test.sentence(), pr.test.duration_s, pr.between, pr.separation)
 
 
 def plan_test(diagnosed, cfg=None, fmu_dir="fmus", nominal=None) -> tuple[Proposal | None, object]:

@@ -219,7 +219,7 @@ def markdown(d: Diagnosis) -> str:
     lines += _which_lines(d)
     if d.evidence:
         lines += ["", "Evidence:", ""] + [f"- {e}" for e in d.evidence]
-    lines += _separation_lines(d) + _where_lines(g)
+    lines += _separation_lines(d) + _next_test_lines(d) + _where_lines(g)
     lines += ["", "![gap map](gap_map.png)", "", "![overlay](overlay.png)", ""]
     lines += [f"![{name}]({name}.png)\n" for name in d.figures]
     return "\n".join(lines)
@@ -274,6 +274,16 @@ def _separation_lines(d: Diagnosis) -> list[str]:
         line += (f" Both reach the noise with held-out misfits within {100 * selection.ALIKE:.0f} % of each other: "
                  f"{first.effect}, with fewer parameters, is named.")
     return ["", line]
+
+
+def _next_test_lines(d: Diagnosis) -> list[str]:
+    """The test that would decide, where the report is not decisive."""
+    nt = d.next_test
+    if not nt:
+        return []
+    return ["", f"**Next test: {nt.test}.** {nt.between[0]} and {nt.between[1]} differ there by {nt.separation:.1f} "
+            "× the sensor noise (the RMS of their predictions' difference over the noise's): "
+            "`stockbridge plan-test --from` this folder writes its drive file and every test tried."]
 
 
 def _where_lines(g) -> list[str]:

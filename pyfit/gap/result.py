@@ -129,6 +129,17 @@ class Separation:
 
 
 @dataclass(frozen=True)
+class NextTest:
+    """The test a report that is not decisive proposes (pyfit.gap.proposal): what to run, its length [s], the two
+    models it separates and by how much (the RMS of their predictions' difference over the sensor noise's)."""
+
+    test: str
+    duration_s: float
+    between: tuple[str, str]
+    separation: float
+
+
+@dataclass(frozen=True)
 class Diagnosis:
     """A diagnosis: the verdict, the effects it names, where the gap is, the ranked models, the evidence and the
     stated confidence, with what the data were and how the run went."""
@@ -160,6 +171,7 @@ class Diagnosis:
     # compared above (a displacement integrated from an accelerometer drifts below it)
     stage_s: dict = dataclasses.field(default_factory=dict)
     figures: tuple[str, ...] = ()  # the figures beyond the gap map and the overlay
+    next_test: NextTest | None = None  # where the report is not decisive: the test that would decide
 
     @property
     def significant(self) -> bool:
@@ -210,7 +222,9 @@ class Diagnosis:
             evidence=tuple(d["evidence"]), nominal=NominalFit(**d["nominal"]),
             calibration_files=tuple(d["calibration_files"]), held_out_files=tuple(d["held_out_files"]),
             separation=Separation(tuple(sep["between"]), tuple(sep["levels"]), sep["measure_next"]) if sep else None,
-            voltage_channels=tuple(d.get("voltage_channels", ())), figures=tuple(d.get("figures", ())))
+            voltage_channels=tuple(d.get("voltage_channels", ())), figures=tuple(d.get("figures", ())),
+            next_test=NextTest(**{**d["next_test"], "between": tuple(d["next_test"]["between"])})
+            if d.get("next_test") else None)
         return cls(**fields)
 
     @classmethod
