@@ -27,6 +27,7 @@ _stick_velocity = Param("v_s", lambda s: (1e-3 * s.sigma_v, 1e-2 * s.sigma_v, 0.
 # corner of the family lies beyond a bound a real loop reaches.
 TURNOVER_RANGE = (1e-4, 1e2)
 BRANCH_RANGE = (-2.0, 3.0)
+DAMPER_BRANCH_FROM = -1.0  # the damper form's β = (s + d)/2 is declared non-negative (the element's minimum)
 MAX_NU = 6.0
 
 # Shapes of the Bouc-Wen loop the refit starts from, spanning the family (theory §1.1 and §1.3): with β set
@@ -274,8 +275,8 @@ DAMPER = {b.name: b for b in (
            Param("D", shape=True, log=True, range=lambda s: (
                TURNOVER_RANGE[0] * s.sigma_y, _damper_loop(s, DAMPER_LOOP_STARTS[0])["D"],
                TURNOVER_RANGE[1] * s.sigma_y)),
-           Param(BRANCH, shape=True, range=lambda s: (-1.0, _damper_loop(s, DAMPER_LOOP_STARTS[0])[BRANCH],
-                                                      BRANCH_RANGE[1])),
+           Param(BRANCH, shape=True, range=lambda s: (DAMPER_BRANCH_FROM, _damper_loop(
+               s, DAMPER_LOOP_STARTS[0])[BRANCH], BRANCH_RANGE[1])),
            Param("nu", shape=True, range=lambda s: (1.0, DAMPER_LOOP_STARTS[0]["nu"], MAX_NU))),
         fixed=lambda s: {"A": 1.0}, derived=lambda s: (BranchCoordinate(),),
         signature="amplitude-dependent stiffness and damping of the cable (hysteresis loops), odd distortion",
