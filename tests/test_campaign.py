@@ -291,16 +291,18 @@ def test_the_summary_tabulates_the_follow_ups_verdicts_before_and_after():
                 outcome("hysteresis", "cubic_stiffness", "gap explained", 0.005, 0.006, "hysteresis", 30.0),
                 outcome("coulomb_friction", "none", "no significant gap", 0.007, 0.006, "none", 20.0),  # not found
                 outcome("quadratic_damping", "quadratic_damping", "gap explained", 0.005, 0.005),  # decisive
-                outcome("none", "none", "no significant gap", 0.005, 0.006, "quadratic_damping", 40.0)]  # an alarm
+                outcome("none", "none", "no significant gap", 0.005, 0.006, "quadratic_damping", 40.0),  # an alarm
+                {**outcome("hysteresis", "none", "no significant gap", 0.007, 0.006), "follow_up": {"error": "X"}}]
     s = campaign.summarise(outcomes)["follow_up"]
-    assert s == {"cases": 5, "proposed": 4, "effect_cases": 4, "top1_before": 1, "top1_after": 3, "wanting": 3,
+    # a follow-up that failed keeps its case's first verdict (and counts as a miss for want of evidence not followed)
+    assert s == {"cases": 6, "proposed": 4, "effect_cases": 5, "top1_before": 1, "top1_after": 3, "wanting": 4,
                  "wanting_proposed": 3, "wanting_right_after": 2, "null_cases": 1, "false_alarms_before": 0,
-                 "false_alarms_after": 1, "mean_test_s": 25.0}
-    text = campaign.markdown({**campaign.summarise(outcomes), "cases": 5, "seed": 0, "record_s": 6.0,
+                 "false_alarms_after": 1, "failed": 1, "mean_test_s": 25.0}
+    text = campaign.markdown({**campaign.summarise(outcomes), "cases": 6, "seed": 0, "record_s": 6.0,
                               "where": "here", "wall_s": 60.0, "command": "c"})
-    assert "| named right (cases with a withheld effect) | 1 of 4 (25 %) | 3 of 4 (75 %) |" in text
-    assert "named right | 0 of 3 | 2 of 3 (67 %) (3 proposed a test) |" in text
-    assert "Tests proposed: 4 of 5 cases; mean test length 25 s." in text
+    assert "| named right (cases with a withheld effect) | 1 of 5 (20 %) | 3 of 5 (60 %) |" in text
+    assert "named right | 0 of 4 | 2 of 4 (50 %) (3 proposed a test) |" in text
+    assert "Tests proposed and run: 4 of 6 cases (follow-ups that failed: 1); mean test length 25 s." in text
     without = [{k: v for k, v in o.items() if k != "follow_up"} for o in outcomes]  # a campaign without them
     assert campaign.summarise(without)["follow_up"] is None
 

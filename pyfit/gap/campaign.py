@@ -30,10 +30,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from pyfit.gap import confidence, datasets, selection, sizing
+from pyfit.gap import confidence, datasets, follow_up, selection, sizing
 from pyfit.gap.diagnose import DiagnoseConfig, diagnose, load_config, misfit_at
-from pyfit.gap import follow_up as follow_ups
-from pyfit.gap.follow_up import follow_up
 from pyfit.gap.result import Verdict
 from pyfit.gap.effects import BUILTINS, drawn
 from pyfit.gap.systems import FAMILY
@@ -193,7 +191,7 @@ def run_case(job: CaseJob) -> dict:
                        named_held_out=named, noise_floor=rep.gap.noise_floor, explained_below=rep.explained_below,
                        **truth_test(rep.gap.overall, rep.gap.shrink_reference, at_truth.held_out, job.cfg))
         if job.follow_up:
-            outcome["follow_up"] = follow_up(folder, c, data, job.cfg, job.fmu_dir, described)
+            outcome["follow_up"] = follow_up.run(folder, c, data, job.cfg, job.fmu_dir, described)
     except Exception as exc:  # a case that breaks the diagnosis is an outcome of the campaign, not its end
         outcome = {"named": "error", "verdict": f"{type(exc).__name__}: {exc}", "enr": None, "top_shrink_pct": None,
                    "stated": None}
@@ -253,9 +251,9 @@ def run(n: int, out, fmu_dir="fmus", seed: int = 0, workers: int = 2, scheduler=
     Writes OUT/summary.md and OUT/summary.json (a campaign whose every case is stored is summarised again, with
     the wall time of the run that diagnosed them: wall_of_runs); with `calibrate`, its hit rates become the
     package's confidence calibration of `model` with its settings (pyfit.gap.confidence), and the summary states
-    every report's confidence with it (in-sample); `config`: a TOML file of diagnosis settings (pyfit.gap.diagnose.load_config; default: the defaults); with `follow`, each
-    case whose report is not decisive runs the test it proposes on the truth and is diagnosed again
-    (pyfit.gap.follow_up)."""
+    every report's confidence with it (in-sample); `config`: a TOML file of diagnosis settings
+    (pyfit.gap.diagnose.load_config; default: the defaults); with `follow`, each case whose report is not decisive
+    runs the test it proposes on the truth and is diagnosed again (pyfit.gap.follow_up)."""
     if calibrate and excitation:
         raise ValueError("--calibrate takes a campaign of every excitation (a report's confidence is read from it "
                          "whatever its records); drop --excitation")
@@ -423,7 +421,7 @@ def summarise(outcomes: list[dict]) -> dict:
             "errors": sum(o["named"] == "error" for o in outcomes),
             "median_case_s": _median([o["data_s"] + o["diagnose_s"] for o in fresh]),
             "times": times_by_kind(outcomes), "fits_reused": len(outcomes) - len(fresh),
-            "follow_up": follow_ups.summary(outcomes, _miss_cause)}
+            "follow_up": follow_up.summary(outcomes, _miss_cause)}
 
 
 def _share(part: int, whole: int) -> str:
@@ -433,7 +431,7 @@ def _share(part: int, whole: int) -> str:
 def markdown(s: dict) -> str:
     """The campaign summary as Markdown."""
     lines = _headline_lines(s) + _confusion_lines(s) + _size_lines(s) + _miss_lines(s) \
-        + follow_ups.lines(s.get("follow_up")) + _time_lines(s) + _calibration_lines(s)
+        + follow_up.lines(s.get("follow_up")) + _time_lines(s) + _calibration_lines(s)
     return "\n".join(lines) + "\n"
 
 

@@ -238,8 +238,7 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     physical = {k: v for k, v in truth.items() if k != "sensor_delay"}  # the delay is in the recording
 
     def simulated(signal, stop, params):
-        return _truth(SyntheticSpec(family.model, signal, stop, family.fs, list(recorded), params,
-                                    oversample=OVERSAMPLE, rtol=TRUTH_RTOL, atol=TRUTH_ATOL))
+        return _recorded_truth(family, signal, stop, recorded, params)
 
     for i, level in enumerate(levels):
         signal, stop, keep = _level_signal(kind, family, level, style, seed, periods)
@@ -271,6 +270,12 @@ def write_dataset(out_dir, family: Family, effect: str, seed: int = 0, periods: 
     return out
 
 
+def _recorded_truth(family: Family, signal, stop: float, recorded, params: dict) -> tuple:
+    """The truth `params` driven by `signal` for `stop` s through the family's sensor chain: (t, outputs, ...)."""
+    return _truth(SyntheticSpec(family.model, signal, stop, family.fs, list(recorded), params,
+                                oversample=OVERSAMPLE, rtol=TRUTH_RTOL, atol=TRUTH_ATOL))
+
+
 def write_test(data_dir, family: Family, signal, stop_s: float, kind: str, level: float, name: str,
                seed: int) -> pathlib.Path:
     """One more record of the case write_dataset wrote into `data_dir` (its truth.json: the truth and how it was
@@ -284,13 +289,10 @@ def write_test(data_dir, family: Family, signal, stop_s: float, kind: str, level
     recorded = tuple(style["outputs"] or family.outputs)
     physical = {k: v for k, v in truth.items() if k != "sensor_delay"}
 
-    def simulated(params):
-        return _truth(SyntheticSpec(family.model, signal, stop_s, family.fs, list(recorded), params,
-                                    oversample=OVERSAMPLE, rtol=TRUTH_RTOL, atol=TRUTH_ATOL))
-
-    t, exact, _ = simulated(physical)
+    t, exact, _ = _recorded_truth(family, signal, stop_s, recorded, physical)
     keep = slice(0, int(round(stop_s * family.fs)))
-    clean = simulated({**physical, **family.tangent})[1]  # the noise of a non-displacement output: write_dataset's
+    # the noise of a non-displacement output follows the truth without its effects, as in write_dataset
+    clean = _recorded_truth(family, signal, stop_s, recorded, {**physical, **family.tangent})[1]
     tk, rng = t[keep] - t[keep][0], np.random.default_rng(seed)
     inputs = _recorded_inputs(family, kind, signal, t[keep] + truth.get("sensor_delay", 0.0), style["motion"])
     outputs = {f"{o}_meas": (exact[o][keep] + rng.normal(0.0, _noise_of(family, o, clean[o][keep]), len(tk)),
@@ -299,13 +301,13 @@ def write_test(data_dir, family: Family, signal, stop_s: float, kind: str, level
     path = out / f"{name}.csv"
     write_measurement(path, family.model, tk, inputs, outputs, level=f"amplitude {level:g} {unit}", level_value=level,
                       excitation=_excitation_meta(kind, signal, dataclasses.replace(
-                          family, band_hz=_band_of(signal, family)), level, family.samples_per_period, 0),
+                          family, band_hz=_band_of(signal)), level, family.samples_per_period, 0),
                       notes=f"synthetic: the case's truth on a further test (CasADi reference, the same sensor "
                             f"chain), noise seed {seed}")
     return path
 
 
-def _band_of(signal, family: Family) -> tuple:
+def _band_of(signal) -> tuple:
     """The frequency range [Hz] a sweep or stepped sine covers."""
     if isinstance(signal, SteppedSine):
         return min(signal.frequencies), max(signal.frequencies)

@@ -80,6 +80,11 @@ def _sdof_loop(s: Scale, share: float, width: float, shape: dict) -> dict:
                                width * shape["delta"], shape["nu"])}
 
 
+def _default_sdof_loop(s: Scale) -> dict:
+    """The default start: the first listed shape at the default share."""
+    return _sdof_loop(s, DEFAULT_SHARE, 1.0, SDOF_LOOP_STARTS[0])
+
+
 def _sdof_loop_starts(s: Scale) -> list[dict]:
     """Every loop shape at every width and each of its hysteretic shares of the calibrated stiffness, but the
     default start (the first shape, as listed, at the default share)."""
@@ -204,10 +209,9 @@ SDOF = {b.name: b for b in (
         "hysteresis",
         (Param("alpha", lambda s: (0.0, DEFAULT_SHARE * s.k, 2.0 * s.k)),
          Param(TURNOVER, shape=True, log=True, range=lambda s: (
-             TURNOVER_RANGE[0] * s.k * s.sigma_y, _sdof_loop(s, DEFAULT_SHARE, 1.0, SDOF_LOOP_STARTS[0])[TURNOVER],
+             TURNOVER_RANGE[0] * s.k * s.sigma_y, _default_sdof_loop(s)[TURNOVER],
              TURNOVER_RANGE[1] * s.k * s.sigma_y)),
-         Param(BRANCH, shape=True, range=lambda s: (BRANCH_RANGE[0], _sdof_loop(
-             s, DEFAULT_SHARE, 1.0, SDOF_LOOP_STARTS[0])[BRANCH], BRANCH_RANGE[1])),
+         Param(BRANCH, shape=True, range=lambda s: (BRANCH_RANGE[0], _default_sdof_loop(s)[BRANCH], BRANCH_RANGE[1])),
          Param("nu", shape=True, range=lambda s: (1.0, SDOF_LOOP_STARTS[0]["nu"], MAX_NU))),
         derived=lambda s: (LoopCoordinates(),),
         basin=sdof_loop_basin,

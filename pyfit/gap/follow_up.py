@@ -11,18 +11,27 @@ import shutil
 from pyfit.gap import datasets
 from pyfit.gap.diagnose import diagnose
 from pyfit.gap.proposal import plan_test, write_plan
+from pyfit.gap.result import Diagnosis
 
 FOLLOW_UP_SEED = 7919  # added to a case's noise seed for the follow-up record's noise (another record, other noise)
 TEST_NAME = "follow_up_test"
 
 
-def follow_up(folder: pathlib.Path, case, data: pathlib.Path, cfg, fmu_dir, described) -> dict | None:
-    """The follow-up of the case diagnosed in folder/diagnosis from `data` (None when its report proposes no test):
-    the proposed test, its length [s] and predicted separation, and the verdict of the dataset with it, diagnosed
-    in folder/follow_up/diagnosis."""
-    pr, (d, records, system) = plan_test(folder / "diagnosis", cfg, fmu_dir, described)
-    if pr is None:
+def run(folder: pathlib.Path, case, data: pathlib.Path, cfg, fmu_dir, described) -> dict | None:
+    """The follow-up of the case diagnosed in folder/diagnosis from `data` (None when its report names no next
+    test): the proposed test, its length [s] and predicted separation, and the verdict of the dataset with it,
+    diagnosed in folder/follow_up/diagnosis; {"error": ...} when the follow-up fails (the first diagnosis stands)."""
+    if Diagnosis.read(folder / "diagnosis" / "report.json").next_test is None:
         return None
+    try:
+        return _recorded_and_diagnosed(folder, case, data, cfg, fmu_dir, described)
+    except Exception as exc:  # a follow-up that breaks is part of the case's outcome, not its end
+        return {"error": f"{type(exc).__name__}: {exc}"}
+
+
+def _recorded_and_diagnosed(folder, case, data, cfg, fmu_dir, described) -> dict:
+    """The proposed test (plan_test: its signal) recorded on the truth into a copy of the dataset, diagnosed."""
+    pr, (d, records, system) = plan_test(folder / "diagnosis", cfg, fmu_dir, described)
     write_plan(pr, d, records, system, folder / "diagnosis")
     more = folder / "follow_up" / "data"
     if more.exists():
@@ -50,22 +59,23 @@ def summary(outcomes: list[dict], miss_cause) -> dict | None:
     ran = [o for o in outcomes if "follow_up" in o]
     if not ran:
         return None
-    proposed = [o for o in ran if o["follow_up"]]
+    proposed = [o for o in ran if o["follow_up"] and "named" in o["follow_up"]]
     effects = [o for o in ran if o["withheld"] != "none"]
     nulls = [o for o in ran if o["withheld"] == "none"]
 
     def after(o):
-        return o["follow_up"]["named"] if o.get("follow_up") else o["named"]
+        return (o.get("follow_up") or {}).get("named", o["named"])
 
     wanting = [o for o in effects if o["named"] != o["withheld"] and o.get("truth_held_out") is not None
                and miss_cause(o) in ("undetected", "undecided")]
     return {"cases": len(ran), "proposed": len(proposed), "effect_cases": len(effects),
             "top1_before": sum(o["named"] == o["withheld"] for o in effects),
             "top1_after": sum(after(o) == o["withheld"] for o in effects),
-            "wanting": len(wanting), "wanting_proposed": sum(bool(o["follow_up"]) for o in wanting),
+            "wanting": len(wanting), "wanting_proposed": sum(o in proposed for o in wanting),
             "wanting_right_after": sum(after(o) == o["withheld"] for o in wanting),
             "null_cases": len(nulls), "false_alarms_before": sum(o["named"] != "none" for o in nulls),
             "false_alarms_after": sum(after(o) != "none" for o in nulls),
+            "failed": sum(bool(o["follow_up"]) and "error" in o["follow_up"] for o in ran),
             "mean_test_s": (sum(o["follow_up"]["test_s"] for o in proposed) / len(proposed)) if proposed else None}
 
 
@@ -87,4 +97,5 @@ def lines(s: dict | None) -> list[str]:
             f"{share(s['wanting_right_after'], s['wanting'])} ({s['wanting_proposed']} proposed a test) |",
             f"| false alarms (null cases) | {share(s['false_alarms_before'], s['null_cases'])} | "
             f"{share(s['false_alarms_after'], s['null_cases'])} |",
-            "", f"Tests proposed: {s['proposed']} of {s['cases']} cases; mean test length {mean}."]
+            "", f"Tests proposed and run: {s['proposed']} of {s['cases']} cases (follow-ups that failed: "
+            f"{s['failed']}); mean test length {mean}."]

@@ -138,11 +138,16 @@ def propose(runner, d: Diagnosis, params: dict, records, bands, upsample: int, l
     return Proposal(pair, best[0], best[1], tuple(tried))
 
 
-def next_test(runner, d: Diagnosis, records, upsample: int, lead_periods: int, clamp: bool) -> NextTest | None:
-    """The report's next test (propose, with each ranked model's and the nominal's values and the gap map's
-    bands); None for a decisive report."""
+def proposed_for(runner, d: Diagnosis, records, upsample: int, lead_periods: int, clamp: bool) -> Proposal | None:
+    """propose for a report: with each ranked model's and the nominal's values and the gap map's bands."""
     params = {**{f.effect: f.values for f in d.ranking}, "nominal": d.nominal.values}
-    pr = propose(runner, d, params, records, [tuple(b.band_hz) for b in d.gap.by_band], upsample, lead_periods, clamp)
+    return propose(runner, d, params, records, [tuple(b.band_hz) for b in d.gap.by_band], upsample, lead_periods,
+                   clamp)
+
+
+def next_test(runner, d: Diagnosis, records, upsample: int, lead_periods: int, clamp: bool) -> NextTest | None:
+    """The report's next test (proposed_for); None for a decisive report."""
+    pr = proposed_for(runner, d, records, upsample, lead_periods, clamp)
     return None if pr is None else NextTest(pr.test.sentence(), pr.test.duration_s, pr.between, pr.separation)
 
 
@@ -159,10 +164,8 @@ def plan_test(diagnosed, cfg=None, fmu_dir="fmus", nominal=None) -> tuple[Propos
                          "diagnose the dataset again into that folder (its stored fits are read, not redone)")
     p = prepare(d.model, d.source, cfg or DiagnoseConfig(), fmu_dir, nominal)
     try:
-        params = {**{f.effect: f.values for f in d.ranking}, "nominal": d.nominal.values}
-        bands = [tuple(b.band_hz) for b in d.gap.by_band]
-        pr = propose(p.runner, d, params, p.data.records, bands, p.cfg.upsample, p.system.lead_periods,
-                     bool(p.system.motion_inputs))
+        pr = proposed_for(p.runner, d, p.data.records, p.cfg.upsample, p.system.lead_periods,
+                          bool(p.system.motion_inputs))
     finally:
         p.runner.close()
     return pr, (d, p.data.records, p.system)
